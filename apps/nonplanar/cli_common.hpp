@@ -1,0 +1,36 @@
+// Pieces every nonplanar subcommand shares: mesh-loading options, error reporting,
+// progress on stderr.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <string>
+
+#include "nonplanar/context.hpp"
+#include "nonplanar/io.hpp"
+#include "nonplanar/status.hpp"
+
+namespace nonplanar::cli {
+
+/// Exit codes: 0 success, 2 bad input or arguments, 1 anything else (an internal failure).
+constexpr int kExitOk = 0;
+constexpr int kExitFailure = 1;
+constexpr int kExitBadInput = 2;
+
+/// Options for reading and placing the model, added to a subcommand.
+struct MeshOptions {
+  std::string model;
+  LoadParams load;
+  bool quiet = false;
+  void add_to(CLI::App& cmd);
+};
+
+/// Prints "error: MESSAGE" on stderr; returns the exit code for the status.
+int report_error(const Error& e);
+/// Prints "warning: FILE: MESSAGE" for each loader warning (unless quiet).
+void report_warnings(const std::string& file, const LoadedMesh& m, bool quiet);
+/// A Context that draws a progress line on stderr when it is a terminal and not quiet.
+Context make_context(bool quiet);
+/// Clears the progress line, if one was drawn.
+void finish_progress();
+
+}  // namespace nonplanar::cli

@@ -1,0 +1,12 @@
+// Subcommands of the nonplanar CLI; each registers its options and returns an exit code.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <functional>
+
+namespace nonplanar::cli {
+
+/// Adds "analyze" to app; *run is set to the function main calls when it is chosen.
+void register_analyze(CLI::App& app, std::function<int()>* run);
+
+}  // namespace nonplanar::cli

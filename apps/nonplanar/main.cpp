@@ -1,0 +1,34 @@
+// nonplanar: non-planar FDM slicing. This file only wires subcommands; the work is in the
+// library (include/nonplanar, src/).
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <exception>
+#include <functional>
+
+#include "cli_common.hpp"
+#include "commands.hpp"
+
+int main(int argc, char** argv) {
+  using namespace nonplanar::cli;
+  CLI::App app{
+      "nonplanar - slice FDM parts with curved (non-planar) top layers.\n"
+      "Run 'nonplanar COMMAND --help' for the options of a command."};
+  app.set_version_flag("--version", "nonplanar 0.1.0");
+  app.require_subcommand(1);
+  std::function<int()> run;
+  register_analyze(app, &run);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int rc = app.exit(e);
+    return rc == 0 ? kExitOk : kExitBadInput;
+  }
+  try {
+    return run ? run() : kExitBadInput;
+  } catch (const std::bad_alloc&) {
+    std::fprintf(stderr, "error: out of memory\n");
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "error: internal: %s\n", e.what());
+  }
+  return kExitFailure;
+}

@@ -1,0 +1,57 @@
+// Stage io: read meshes (STL, OBJ, OFF, 3MF), repair and place them; write meshes.
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "nonplanar/context.hpp"
+#include "nonplanar/mesh.hpp"
+#include "nonplanar/status.hpp"
+
+namespace nonplanar {
+
+enum class MeshFormat { stl_binary, stl_ascii, obj, off, threemf };
+const char* format_name(MeshFormat f);
+
+/// Inputs of load_mesh. Angles in degrees, lengths in mm.
+struct LoadParams {
+  double scale = 1.0;           ///< uniform scale applied first (must be finite and > 0)
+  double rotate_x_deg = 0.0;    ///< then rotations about X, Y, Z, in that order
+  double rotate_y_deg = 0.0;
+  double rotate_z_deg = 0.0;
+  bool place_on_bed = true;     ///< XY bbox centre at bed_center, lowest point at z = 0
+  Vec2 bed_center{110.0, 110.0};
+  /// Weld tolerance as a fraction of the bounding-box diagonal (1e-7 of 100 mm = 0.01 µm
+  /// would be too tight for float STL noise; 1e-6 closes near-coincident vertices safely).
+  double weld_tolerance_rel = 1e-6;
+  std::size_t max_triangles = 50'000'000;  ///< refuse larger inputs with a clear error
+};
+
+/// Output of load_mesh: the welded, consistently oriented, placed mesh and what was fixed.
+struct LoadedMesh {
+  TriangleMesh mesh;
+  MeshDefects defects;
+  MeshFormat format = MeshFormat::stl_binary;
+  std::size_t input_triangles = 0;
+  double weld_tolerance = 0.0;           ///< absolute, mm
+  std::vector<std::string> warnings;     ///< one line each, without the file name
+};
+
+/// Read, weld, orient and place a mesh. The format is chosen by extension (.stl .obj .off
+/// .3mf, case-insensitive). Errors: "FILE: what is wrong" with Status io_error,
+/// parse_error or invalid_mesh; never a crash on malformed input.
+Expected<LoadedMesh> load_mesh(const std::filesystem::path& file, const LoadParams& params,
+                               const Context& ctx);
+
+/// Binary STL writer (used by tests, benchmarks and later stages). Atomic.
+Expected<bool> write_stl(const std::filesystem::path& file, const TriangleMesh& mesh);
+
+/// 3MF writer: one mesh object, one build item with no transform. Atomic.
+Expected<bool> write_3mf(const std::filesystem::path& file, const TriangleMesh& mesh);
+
+/// ASCII PLY with one RGB colour per face (face_colors: F entries, 0xRRGGBB). Atomic.
+Expected<bool> write_ply_face_colors(const std::filesystem::path& file, const TriangleMesh& mesh,
+                                     const std::vector<unsigned>& face_colors);
+
+}  // namespace nonplanar

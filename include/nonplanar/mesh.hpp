@@ -1,0 +1,58 @@
+// The triangle mesh value type shared by every stage, and the defect report of the loader.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <array>
+#include <cstddef>
+#include <vector>
+
+namespace nonplanar {
+
+using Vec2 = Eigen::Vector2d;
+using Vec3 = Eigen::Vector3d;
+
+/// Indexed triangle mesh in millimetres.
+/// vertices: V points; faces: F triangles of vertex indices, counter-clockwise seen from
+/// outside (so the right-hand normal points out of the part).
+struct TriangleMesh {
+  std::vector<Vec3> vertices;
+  std::vector<std::array<int, 3>> faces;
+};
+
+/// Axis-aligned bounding box; empty when min > max.
+struct BoundingBox {
+  Vec3 min{1e300, 1e300, 1e300};
+  Vec3 max{-1e300, -1e300, -1e300};
+  bool empty() const { return min.x() > max.x(); }
+  Vec3 size() const { return empty() ? Vec3::Zero() : Vec3(max - min); }
+  void extend(const Vec3& p) {
+    min = min.cwiseMin(p);
+    max = max.cwiseMax(p);
+  }
+};
+
+/// Bounding box of all vertices (including unreferenced ones).
+BoundingBox bounding_box(const TriangleMesh& mesh);
+
+/// Signed volume in mm³ (positive for a closed, outward-oriented mesh).
+double signed_volume(const TriangleMesh& mesh);
+
+/// What the loader found wrong with the input, counted on the welded mesh before repair.
+struct MeshDefects {
+  std::size_t open_edges = 0;           ///< edges with exactly one face
+  std::size_t non_manifold_edges = 0;   ///< edges with three or more faces
+  std::size_t inconsistent_edges = 0;   ///< manifold edges whose two faces disagree on winding
+  std::size_t zero_area_faces = 0;      ///< faces whose height is below the weld tolerance
+  std::size_t collapsed_faces = 0;      ///< faces dropped because welding merged two corners
+  std::size_t shells = 0;               ///< connected components
+  std::size_t faces_flipped = 0;        ///< faces whose winding the loader reversed
+  bool was_inverted = false;            ///< a whole shell pointed inward and was flipped
+  bool closed() const { return open_edges == 0 && non_manifold_edges == 0; }
+  bool any() const {
+    return open_edges || non_manifold_edges || inconsistent_edges || zero_area_faces ||
+           collapsed_faces || was_inverted;
+  }
+};
+
+}  // namespace nonplanar

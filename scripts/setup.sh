@@ -1,0 +1,43 @@
+#!/usr/bin/env bash
+# Install every Debian package the build, tests and benchmarks need.
+# Idempotent: packages already present are skipped, and apt is not touched at all when
+# nothing is missing. Run as root on Debian 12 (uses sudo when not root and available).
+#
+# Usage: scripts/setup.sh [--with-prusaslicer]
+#   --with-prusaslicer  also install prusa-slicer (planar reference in benchmarks, external
+#                       engine); large, so only the benchmark/engine paths ask for it.
+set -euo pipefail
+
+pkgs=(
+  build-essential cmake ninja-build pkg-config
+  libeigen3-dev libceres-dev libtbb-dev libpolyclipping-dev lib3mf-dev
+  libcli11-dev nlohmann-json3-dev libfmt-dev libspdlog-dev
+  libgtest-dev libgmock-dev libbenchmark-dev
+  zip unzip
+)
+if [[ "${1:-}" == "--with-prusaslicer" ]]; then
+  pkgs+=(prusa-slicer)
+fi
+
+missing=()
+for p in "${pkgs[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q 'install ok installed'; then
+    missing+=("$p")
+  fi
+done
+
+if ((${#missing[@]} == 0)); then
+  exit 0
+fi
+
+SUDO=""
+if [[ $(id -u) -ne 0 ]]; then
+  if command -v sudo >/dev/null; then SUDO=sudo; else
+    echo "error: setup: need root to install: ${missing[*]}" >&2
+    exit 1
+  fi
+fi
+echo "setup: installing ${missing[*]}" >&2
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -qq
+$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null

@@ -1,0 +1,49 @@
+#include "analysis/facet_selection.hpp"
+
+#include <tbb/parallel_for.h>
+
+#include <cmath>
+
+namespace nonplanar::analysis {
+
+FaceGeometry face_geometry(const TriangleMesh& mesh) {
+  const std::size_t nf = mesh.faces.size();
+  FaceGeometry g;
+  g.normals.resize(nf);
+  g.areas.resize(nf);
+  g.degenerate.resize(nf);
+  const double diag = bounding_box(mesh).size().norm();
+  const double min_area = (1e-9 * diag) * (1e-9 * diag);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nf, 8192),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+                      for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                        const auto& f = mesh.faces[i];
+                        const Vec3& a = mesh.vertices[f[0]];
+                        const Vec3 c = (mesh.vertices[f[1]] - a).cross(mesh.vertices[f[2]] - a);
+                        const double n = c.norm();
+                        g.areas[i] = 0.5 * n;
+                        g.degenerate[i] = g.areas[i] <= min_area;
+                        g.normals[i] = g.degenerate[i] ? Vec3::Zero() : Vec3(c / n);
+                      }
+                    });
+  return g;
+}
+
+std::vector<char> select_facets(const FaceGeometry& geom, const MeshTopology& topo,
+                                double max_angle_rad) {
+  const std::size_t nf = geom.normals.size();
+  const double cos_max = std::cos(max_angle_rad);
+  std::vector<char> painted(nf, 0);
+  for (std::size_t i = 0; i < nf; ++i)
+    painted[i] = !geom.degenerate[i] && geom.normals[i].z() > cos_max;
+  for (std::size_t i = 0; i < nf; ++i) {
+    if (!geom.degenerate[i]) continue;
+    for (int k = 0; k < 3; ++k) {
+      const int g = topo.across[3 * i + k];
+      if (g >= 0 && !geom.degenerate[g] && painted[g]) painted[i] = 1;
+    }
+  }
+  return painted;
+}
+
+}  // namespace nonplanar::analysis

@@ -1,0 +1,19 @@
+// Atomic file output: write to a temporary file beside the target, then rename over it,
+// so a half-written file never exists under the final name.
+#pragma once
+
+#include <filesystem>
+#include <functional>
+#include <ostream>
+
+#include "nonplanar/status.hpp"
+
+namespace nonplanar {
+
+/// Calls write(stream) on a temporary file in the target's folder, flushes it, and renames
+/// it to `file`. On any failure (write returns false, I/O error) the temporary is removed
+/// and an io_error "FILE: reason" is returned.
+Expected<bool> write_file_atomically(const std::filesystem::path& file,
+                                     const std::function<bool(std::ostream&)>& write);
+
+}  // namespace nonplanar

@@ -1,0 +1,111 @@
+#include "io/mesh_buffer.hpp"
+
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <system_error>
+
+namespace nonplanar::io {
+
+Expected<std::string> read_file_bytes(const std::filesystem::path& file, std::size_t max_bytes) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const auto status = fs::status(file, ec);
+  if (ec || !fs::exists(status)) return Error{Status::io_error, "file not found"};
+  if (fs::is_directory(status)) return Error{Status::io_error, "is a folder, not a file"};
+  std::ifstream in(file, std::ios::binary);
+  if (!in) return Error{Status::io_error, std::string("cannot open: ") + std::strerror(errno)};
+  in.seekg(0, std::ios::end);
+  const std::streamoff size = in.tellg();
+  if (size < 0) return Error{Status::io_error, "cannot determine the file size"};
+  if (static_cast<std::size_t>(size) > max_bytes)
+    return Error{Status::invalid_mesh, "file is " + std::to_string(size) +
+                                           " bytes, over the limit of " +
+                                           std::to_string(max_bytes)};
+  in.seekg(0);
+  std::string data(static_cast<std::size_t>(size), '\0');
+  if (size > 0 && !in.read(data.data(), size)) return Error{Status::io_error, "read failed"};
+  return data;
+}
+
+std::optional<double> parse_double(std::string_view t) {
+  if (t.empty()) return std::nullopt;
+  if (t.front() == '+') t.remove_prefix(1);  // from_chars rejects a leading '+'
+  double v = 0;
+  const auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
+  if (ec != std::errc() || end != t.data() + t.size() || !std::isfinite(v)) return std::nullopt;
+  return v;
+}
+
+std::optional<long long> parse_int(std::string_view t) {
+  if (t.empty()) return std::nullopt;
+  if (t.front() == '+') t.remove_prefix(1);
+  long long v = 0;
+  const auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
+  if (ec != std::errc() || end != t.data() + t.size()) return std::nullopt;
+  return v;
+}
+
+void Tokenizer::skip_space() {
+  while (pos_ < text_.size()) {
+    const char c = text_[pos_];
+    if (c == '\n') {
+      ++line_;
+    } else if (c == '\r') {
+      if (pos_ + 1 >= text_.size() || text_[pos_ + 1] != '\n') ++line_;  // lone CR
+    } else if (c != ' ' && c != '\t' && c != '\f' && c != '\v') {
+      break;
+    }
+    ++pos_;
+  }
+}
+
+std::string_view Tokenizer::next() {
+  skip_space();
+  const std::size_t start = pos_;
+  while (pos_ < text_.size()) {
+    const char c = text_[pos_];
+    if (c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\f' || c == '\v') break;
+    ++pos_;
+  }
+  return text_.substr(start, pos_ - start);
+}
+
+std::string_view Tokenizer::rest_of_line() {
+  const std::size_t start = pos_;
+  while (pos_ < text_.size() && text_[pos_] != '\n' && text_[pos_] != '\r') ++pos_;
+  return text_.substr(start, pos_ - start);
+}
+
+void Tokenizer::skip_line() {
+  rest_of_line();
+  if (pos_ < text_.size()) {
+    if (text_[pos_] == '\r' && pos_ + 1 < text_.size() && text_[pos_ + 1] == '\n') ++pos_;
+    ++pos_;
+    ++line_;
+  }
+}
+
+bool Tokenizer::at_end() {
+  skip_space();
+  return pos_ >= text_.size();
+}
+
+Error parse_error_at(int line, const std::string& msg) {
+  return Error{Status::parse_error, "line " + std::to_string(line) + ": " + msg};
+}
+
+std::optional<Error> check_face_indices(const TriangleMesh& mesh) {
+  const auto n = static_cast<long long>(mesh.vertices.size());
+  for (std::size_t i = 0; i < mesh.faces.size(); ++i)
+    for (int v : mesh.faces[i])
+      if (v < 0 || v >= n)
+        return Error{Status::parse_error, "face " + std::to_string(i + 1) + " uses vertex " +
+                                              std::to_string(v + 1) + " but there are only " +
+                                              std::to_string(n) + " vertices"};
+  return std::nullopt;
+}
+
+}  // namespace nonplanar::io

@@ -1,0 +1,29 @@
+// Mesh repair steps of the loader: welding, orientation and placement.
+#pragma once
+
+#include <cstddef>
+
+#include "core/mesh_topology.hpp"
+#include "nonplanar/io.hpp"
+
+namespace nonplanar::io {
+
+/// Merge vertices closer than `tolerance` (mm) and drop faces that lose a corner to the
+/// merge (their count goes to *collapsed). Unreferenced vertices are removed.
+/// Exact duplicates are merged by hashing first, so only unique points meet the slower
+/// tolerant grid search; O(V) expected.
+TriangleMesh weld(const TriangleMesh& raw, double tolerance, std::size_t* collapsed);
+
+/// Faces whose height over their longest edge is below `tolerance` (needles and caps).
+std::size_t count_zero_area_faces(const TriangleMesh& mesh, double tolerance);
+
+/// Make the winding consistent across manifold edges and point every shell outward
+/// (a shell with negative volume is flipped unless it lies inside another shell's
+/// bounding box, where it is a cavity). Returns the number of faces flipped; sets
+/// *inverted when a whole shell was inside out.
+std::size_t orient_outward(TriangleMesh& mesh, const MeshTopology& topo, bool* inverted);
+
+/// Scale, rotate (X, then Y, then Z) and, if asked, place on the bed (DESIGN.md §4).
+void transform_and_place(TriangleMesh& mesh, const LoadParams& params);
+
+}  // namespace nonplanar::io

@@ -1,0 +1,183 @@
+// 3MF reading and writing through lib3mf 1.8's C interface (Debian's lib3mf-dev).
+#include <Model/COM/NMR_DLLInterfaces.h>
+
+#include <Eigen/Geometry>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "core/atomic_file.hpp"
+#include "io/readers.hpp"
+
+namespace nonplanar::io {
+namespace {
+
+using Affine = Eigen::Affine3d;
+
+// Owns one lib3mf handle and releases it.
+struct Handle {
+  NMR::PLib3MFBase* p = nullptr;
+  Handle() = default;
+  Handle(const Handle&) = delete;
+  Handle& operator=(const Handle&) = delete;
+  ~Handle() {
+    if (p) NMR::lib3mf_release(p);
+  }
+};
+
+std::string last_error(NMR::PLib3MFBase* obj) {
+  DWORD code = 0;
+  LPCSTR msg = nullptr;
+  if (obj && NMR::lib3mf_getlasterror(obj, &code, &msg) == 0 && msg && *msg) return msg;
+  return "lib3mf error";
+}
+
+Affine to_affine(const NMR::MODELTRANSFORM& m) {
+  // lib3mf stores rows of the 3x4 matrix [R | t]: x' = R x + t.
+  Affine a = Affine::Identity();
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 4; ++c) a.matrix()(r, c) = m.m_fFields[r][c];
+  return a;
+}
+
+// Appends an object (mesh or components, recursively) under transform `xf`.
+bool append_object(NMR::PLib3MFModelObjectResource* obj, const Affine& xf, TriangleMesh& out,
+                   int depth, std::string* err) {
+  if (depth > 32) {
+    *err = "components nested more than 32 deep (cycle?)";
+    return false;
+  }
+  BOOL is_mesh = false, is_comp = false;
+  NMR::lib3mf_object_ismeshobject(obj, &is_mesh);
+  NMR::lib3mf_object_iscomponentsobject(obj, &is_comp);
+  if (is_mesh) {
+    DWORD nv = 0, nt = 0;
+    if (NMR::lib3mf_meshobject_getvertexcount(obj, &nv) != 0 ||
+        NMR::lib3mf_meshobject_gettrianglecount(obj, &nt) != 0) {
+      *err = last_error(obj);
+      return false;
+    }
+    std::vector<NMR::MODELMESHVERTEX> verts(nv);
+    std::vector<NMR::MODELMESHTRIANGLE> tris(nt);
+    if ((nv && NMR::lib3mf_meshobject_getvertices(obj, verts.data(), nv, nullptr) != 0) ||
+        (nt && NMR::lib3mf_meshobject_gettriangleindices(obj, tris.data(), nt, nullptr) != 0)) {
+      *err = last_error(obj);
+      return false;
+    }
+    const int base = static_cast<int>(out.vertices.size());
+    for (const auto& v : verts) {
+      const Vec3 p(v.m_fPosition[0], v.m_fPosition[1], v.m_fPosition[2]);
+      if (!p.allFinite()) {
+        *err = "vertex coordinate is not a finite number";
+        return false;
+      }
+      out.vertices.push_back(xf * p);
+    }
+    for (const auto& t : tris) {
+      for (DWORD i : t.m_nIndices)
+        if (i >= nv) {
+          *err = "triangle index " + std::to_string(i) + " out of range";
+          return false;
+        }
+      out.faces.push_back({base + static_cast<int>(t.m_nIndices[0]),
+                           base + static_cast<int>(t.m_nIndices[1]),
+                           base + static_cast<int>(t.m_nIndices[2])});
+    }
+    return true;
+  }
+  if (is_comp) {
+    DWORD n = 0;
+    NMR::lib3mf_componentsobject_getcomponentcount(obj, &n);
+    for (DWORD i = 0; i < n; ++i) {
+      Handle comp, child;
+      if (NMR::lib3mf_componentsobject_getcomponent(obj, i, &comp.p) != 0 ||
+          NMR::lib3mf_component_getobjectresource(comp.p, &child.p) != 0) {
+        *err = last_error(obj);
+        return false;
+      }
+      Affine cxf = Affine::Identity();
+      BOOL has = false;
+      NMR::lib3mf_component_hastransform(comp.p, &has);
+      if (has) {
+        NMR::MODELTRANSFORM m;
+        NMR::lib3mf_component_gettransform(comp.p, &m);
+        cxf = to_affine(m);
+      }
+      if (!append_object(child.p, xf * cxf, out, depth + 1, err)) return false;
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
+Expected<TriangleMesh> parse_3mf(std::string_view data) {
+  if (data.empty()) return Error{Status::parse_error, "file is empty"};
+  Handle model, reader;
+  if (NMR::lib3mf_createmodel(&model.p) != 0 ||
+      NMR::lib3mf_model_queryreader(model.p, "3mf", &reader.p) != 0)
+    return Error{Status::internal_error, "cannot create a lib3mf reader"};
+  std::vector<BYTE> buf(data.begin(), data.end());
+  if (NMR::lib3mf_reader_readfrombuffer(reader.p, buf.data(), buf.size()) != 0)
+    return Error{Status::parse_error, "not a valid 3MF file (" + last_error(reader.p) + ")"};
+  Handle items;
+  if (NMR::lib3mf_model_getbuilditems(model.p, &items.p) != 0)
+    return Error{Status::parse_error, "3MF build has no items"};
+  TriangleMesh mesh;
+  BOOL has_next = false;
+  std::string err;
+  while (NMR::lib3mf_builditemiterator_movenext(items.p, &has_next) == 0 && has_next) {
+    Handle item, obj;
+    if (NMR::lib3mf_builditemiterator_getcurrent(items.p, &item.p) != 0 ||
+        NMR::lib3mf_builditem_getobjectresource(item.p, &obj.p) != 0)
+      return Error{Status::parse_error, "3MF build item: " + last_error(items.p)};
+    Affine xf = Affine::Identity();
+    BOOL has = false;
+    NMR::lib3mf_builditem_hasobjecttransform(item.p, &has);
+    if (has) {
+      NMR::MODELTRANSFORM m;
+      NMR::lib3mf_builditem_getobjecttransform(item.p, &m);
+      xf = to_affine(m);
+    }
+    if (!append_object(obj.p, xf, mesh, 0, &err))
+      return Error{Status::parse_error, "3MF object: " + err};
+  }
+  if (mesh.faces.empty()) return Error{Status::invalid_mesh, "3MF build holds no triangles"};
+  return mesh;
+}
+
+}  // namespace nonplanar::io
+
+namespace nonplanar {
+
+Expected<bool> write_3mf(const std::filesystem::path& file, const TriangleMesh& mesh) {
+  using io::Handle;
+  Handle model, obj, item, writer;
+  if (NMR::lib3mf_createmodel(&model.p) != 0 ||
+      NMR::lib3mf_model_addmeshobject(model.p, &obj.p) != 0)
+    return Error{Status::internal_error, file.string() + ": cannot create a 3MF model"};
+  std::vector<NMR::MODELMESHVERTEX> verts(mesh.vertices.size());
+  for (std::size_t i = 0; i < verts.size(); ++i)
+    for (int k = 0; k < 3; ++k)
+      verts[i].m_fPosition[k] = static_cast<float>(mesh.vertices[i][k]);
+  std::vector<NMR::MODELMESHTRIANGLE> tris(mesh.faces.size());
+  for (std::size_t i = 0; i < tris.size(); ++i)
+    for (int k = 0; k < 3; ++k) tris[i].m_nIndices[k] = static_cast<DWORD>(mesh.faces[i][k]);
+  if (NMR::lib3mf_meshobject_setgeometry(obj.p, verts.data(), static_cast<DWORD>(verts.size()),
+                                         tris.data(), static_cast<DWORD>(tris.size())) != 0 ||
+      NMR::lib3mf_model_addbuilditem(model.p, obj.p, nullptr, &item.p) != 0 ||
+      NMR::lib3mf_model_querywriter(model.p, "3mf", &writer.p) != 0)
+    return Error{Status::internal_error, file.string() + ": " + io::last_error(model.p)};
+  ULONG64 size = 0;
+  if (NMR::lib3mf_writer_getstreamsize(writer.p, &size) != 0)
+    return Error{Status::internal_error, file.string() + ": " + io::last_error(writer.p)};
+  std::vector<BYTE> buf(size);
+  if (NMR::lib3mf_writer_writetobuffer(writer.p, buf.data(), size) != 0)
+    return Error{Status::internal_error, file.string() + ": " + io::last_error(writer.p)};
+  return write_file_atomically(file, [&](std::ostream& out) {
+    out.write(reinterpret_cast<const char*>(buf.data()), static_cast<std::streamsize>(buf.size()));
+    return bool(out);
+  });
+}
+
+}  // namespace nonplanar

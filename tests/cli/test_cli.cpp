@@ -1,0 +1,83 @@
+// The CLI as a user runs it: exit codes, one-line errors, JSON keys, exported files.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <array>
+#include <cstdio>
+#include <nlohmann/json.hpp>
+
+#include "support/files.hpp"
+#include "support/solids.hpp"
+
+namespace nonplanar {
+namespace {
+
+struct CliResult {
+  int code;
+  std::string out, err;
+};
+
+CliResult run(const std::string& args) {
+  const auto dir = test::temp_dir("cli_run");
+  const std::string cmd = std::string(NONPLANAR_CLI) + " " + args + " >" + (dir / "out").string() +
+                          " 2>" + (dir / "err").string();
+  const int status = std::system(cmd.c_str());
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status),
+          test::read_bytes(dir / "out"), test::read_bytes(dir / "err")};
+}
+
+TEST(Cli, AnalyzeJsonReportsPatches) {
+  const auto dir = test::temp_dir("cli_json");
+  const double t = std::tan(15.0 * M_PI / 180.0);
+  ASSERT_TRUE(write_stl(dir / "roof.stl",
+                        test::height_field_solid(
+                            [&](double x, double) { return 5 + t * (10 - std::abs(x - 10)); }, 0,
+                            20, 0, 30, 8, 6)));
+  const CliResult r = run("analyze --json " + (dir / "roof.stl").string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["painted_faces"], 96);
+  EXPECT_EQ(j["nonplanar_patches"], 2);
+  ASSERT_EQ(j["patches"].size(), 2u);
+  EXPECT_TRUE(j["patches"][0]["needs_nonplanar"].get<bool>());
+  EXPECT_NEAR(j["patches"][0]["max_slope"].get<double>(), 15.0, 1e-4);  // float STL
+  EXPECT_EQ(j["mesh"]["bbox_min"][2], 0.0);
+}
+
+TEST(Cli, ExportPatchesWritesAColouredPly) {
+  const auto dir = test::temp_dir("cli_ply");
+  ASSERT_TRUE(write_stl(dir / "s.stl", test::icosphere({0, 0, 0}, 15, 3)));
+  const CliResult r = run("analyze -q " + (dir / "s.stl").string() + " --export-patches " +
+                    (dir / "p.ply").string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string ply = test::read_bytes(dir / "p.ply");
+  EXPECT_EQ(ply.rfind("ply\nformat ascii 1.0\n", 0), 0u);
+  EXPECT_NE(ply.find("element face 1280\n"), std::string::npos);
+}
+
+TEST(Cli, BadInputIsOneLineAndExitTwo) {
+  const auto dir = test::temp_dir("cli_bad");
+  test::write_bytes(dir / "empty.stl", "");
+  test::write_bytes(dir / "junk.obj", "v 1 2 3\nf 1 2 3\n");
+  for (const std::string f : {"empty.stl", "junk.obj", "missing.off"}) {
+    const CliResult r = run("analyze " + (dir / f).string());
+    EXPECT_EQ(r.code, 2) << f;
+    EXPECT_EQ(r.err.rfind("error: " + (dir / f).string() + ": ", 0), 0u) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_TRUE(r.out.empty());
+  }
+  const CliResult bad_angle = run("analyze --max-angle 95 " + (dir / "empty.stl").string());
+  EXPECT_EQ(bad_angle.code, 2);
+}
+
+TEST(Cli, HelpAndUsage) {
+  const CliResult h = run("analyze --help");
+  EXPECT_EQ(h.code, 0);
+  EXPECT_NE(h.out.find("--max-angle"), std::string::npos);
+  EXPECT_NE(h.out.find("--export-patches"), std::string::npos);
+  EXPECT_EQ(run("").code, 2);
+  EXPECT_EQ(run("frobnicate").code, 2);
+}
+
+}  // namespace
+}  // namespace nonplanar

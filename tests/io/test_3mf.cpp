@@ -1,0 +1,84 @@
+#include <Model/COM/NMR_DLLInterfaces.h>
+#include <gtest/gtest.h>
+
+#include "io/readers.hpp"
+#include "support/files.hpp"
+#include "support/solids.hpp"
+
+namespace nonplanar {
+namespace {
+
+TEST(ThreeMf, RoundTrip) {
+  const auto dir = test::temp_dir("3mf_roundtrip");
+  const TriangleMesh m =
+      test::height_field_solid([](double x, double) { return 4 + 0.2 * x; }, 0, 10, 0, 5, 4, 3);
+  ASSERT_TRUE(write_3mf(dir / "a.3mf", m));
+  auto r = load_mesh(dir / "a.3mf", test::unplaced(), {});
+  ASSERT_TRUE(r) << r.error().message;
+  EXPECT_EQ(r->format, MeshFormat::threemf);
+  EXPECT_EQ(r->mesh.faces.size(), m.faces.size());
+  EXPECT_NEAR(signed_volume(r->mesh), signed_volume(m), 1e-4);
+  EXPECT_TRUE(r->defects.closed());
+}
+
+// Two build items of one object, each with its own transform: both must come in, moved.
+TEST(ThreeMf, BuildItemsAndTransformsAreApplied) {
+  const auto dir = test::temp_dir("3mf_transform");
+  const TriangleMesh cube = test::box({0, 0, 0}, {1, 1, 1});
+  NMR::PLib3MFModel* model = nullptr;
+  NMR::PLib3MFModelMeshObject* obj = nullptr;
+  ASSERT_EQ(NMR::lib3mf_createmodel(&model), 0);
+  ASSERT_EQ(NMR::lib3mf_model_addmeshobject(model, &obj), 0);
+  std::vector<NMR::MODELMESHVERTEX> v(cube.vertices.size());
+  for (std::size_t i = 0; i < v.size(); ++i)
+    for (int k = 0; k < 3; ++k) v[i].m_fPosition[k] = static_cast<float>(cube.vertices[i][k]);
+  std::vector<NMR::MODELMESHTRIANGLE> t(cube.faces.size());
+  for (std::size_t i = 0; i < t.size(); ++i)
+    for (int k = 0; k < 3; ++k) t[i].m_nIndices[k] = static_cast<DWORD>(cube.faces[i][k]);
+  ASSERT_EQ(NMR::lib3mf_meshobject_setgeometry(obj, v.data(), static_cast<DWORD>(v.size()),
+                                               t.data(), static_cast<DWORD>(t.size())),
+            0);
+  NMR::MODELTRANSFORM a{}, b{};
+  for (int k = 0; k < 3; ++k) a.m_fFields[k][k] = b.m_fFields[k][k] = 1;
+  a.m_fFields[0][3] = 10;  // translate x by 10
+  b.m_fFields[0][0] = 2;   // scale x by 2, then move z by 5
+  b.m_fFields[2][3] = 5;
+  NMR::PLib3MFModelBuildItem *ia = nullptr, *ib = nullptr;
+  ASSERT_EQ(NMR::lib3mf_model_addbuilditem(model, obj, &a, &ia), 0);
+  ASSERT_EQ(NMR::lib3mf_model_addbuilditem(model, obj, &b, &ib), 0);
+  NMR::PLib3MFModelWriter* writer = nullptr;
+  ASSERT_EQ(NMR::lib3mf_model_querywriter(model, "3mf", &writer), 0);
+  ASSERT_EQ(NMR::lib3mf_writer_writetofileutf8(writer, (dir / "two.3mf").c_str()), 0);
+  for (auto* p : {writer, ia, ib, obj, model}) NMR::lib3mf_release(p);
+
+  auto r = load_mesh(dir / "two.3mf", test::unplaced(), {});
+  ASSERT_TRUE(r) << r.error().message;
+  EXPECT_EQ(r->mesh.faces.size(), 24u);
+  EXPECT_EQ(r->defects.shells, 2u);
+  EXPECT_NEAR(signed_volume(r->mesh), 1.0 + 2.0, 1e-6);
+  const BoundingBox box = bounding_box(r->mesh);
+  EXPECT_NEAR(box.min.x(), 0.0, 1e-6);
+  EXPECT_NEAR(box.max.x(), 11.0, 1e-6);
+  EXPECT_NEAR(box.max.z(), 6.0, 1e-6);
+}
+
+TEST(ThreeMfErrors, ZipThatIsNot3mfAndRandomBytes) {
+  const auto dir = test::temp_dir("3mf_bad");
+  // A valid zip (stored, one empty file "a.txt"), but no 3MF model inside.
+  const unsigned char zip[] = {
+      0x50, 0x4b, 0x03, 0x04, 0x0a, 0, 0, 0, 0, 0, 0, 0, 0x21, 0, 0, 0, 0, 0, 0, 0, 0, 0,
+      0, 0, 0, 0, 0x05, 0, 0, 0, 'a', '.', 't', 'x', 't', 0x50, 0x4b, 0x01, 0x02, 0x14, 0,
+      0x0a, 0, 0, 0, 0, 0, 0, 0, 0x21, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0x05, 0, 0,
+      0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 'a', '.', 't', 'x', 't', 0x50, 0x4b,
+      0x05, 0x06, 0, 0, 0, 0, 0x01, 0, 0x01, 0, 0x33, 0, 0, 0, 0x23, 0, 0, 0, 0, 0};
+  test::write_bytes(dir / "zip.3mf", std::string(reinterpret_cast<const char*>(zip), sizeof zip));
+  auto r = load_mesh(dir / "zip.3mf", {}, {});
+  ASSERT_FALSE(r);
+  EXPECT_EQ(r.error().status, Status::parse_error);
+  EXPECT_NE(r.error().message.find("not a valid 3MF"), std::string::npos) << r.error().message;
+  EXPECT_FALSE(io::parse_3mf("this is not a zip at all"));
+  EXPECT_FALSE(io::parse_3mf(""));
+}
+
+}  // namespace
+}  // namespace nonplanar

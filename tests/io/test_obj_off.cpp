@@ -1,0 +1,103 @@
+#include <gtest/gtest.h>
+
+#include "io/readers.hpp"
+#include "support/files.hpp"
+#include "support/solids.hpp"
+
+namespace nonplanar {
+namespace {
+
+// A unit cube as 6 quads, using every OBJ index form.
+const char* kCubeObj =
+    "# cube\nmtllib x.mtl\no cube\n"
+    "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1 1.0\n"
+    "vt 0 0\nvn 0 0 1\ns off\n"
+    "f 1 4 3 2\n"                  // bottom
+    "f 5/1 6/1 7/1 8/1\n"          // top
+    "f 1//1 2//1 6//1 5//1\n"      // front
+    "f 2/1/1 3/1/1 7/1/1 6/1/1\n"  // right
+    "f -6 -5 -1 -2\n"              // back: 3 4 8 7 counted from the end
+    "f 4 1 5 8\n";                 // left
+
+TEST(Obj, QuadsAndIndexFormsMakeAClosedCube) {
+  auto r = io::parse_obj(kCubeObj);
+  ASSERT_TRUE(r) << r.error().message;
+  EXPECT_EQ(r->faces.size(), 12u);
+  EXPECT_NEAR(signed_volume(*r), 1.0, 1e-12);
+}
+
+TEST(Obj, LoaderWeldsAndPlaces) {
+  const auto dir = test::temp_dir("obj_load");
+  test::write_bytes(dir / "cube.OBJ", kCubeObj);
+  LoadParams p;
+  p.scale = 10;
+  auto r = load_mesh(dir / "cube.OBJ", p, {});
+  ASSERT_TRUE(r) << r.error().message;
+  const BoundingBox b = bounding_box(r->mesh);
+  EXPECT_NEAR(b.min.z(), 0.0, 1e-12);
+  EXPECT_NEAR(0.5 * (b.min.x() + b.max.x()), 110.0, 1e-9);
+  EXPECT_NEAR(0.5 * (b.min.y() + b.max.y()), 110.0, 1e-9);
+  EXPECT_NEAR(signed_volume(r->mesh), 1000.0, 1e-9);
+  EXPECT_TRUE(r->defects.closed());
+}
+
+TEST(ObjErrors, IndexOutOfRangeNamesTheLine) {
+  auto r = io::parse_obj("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 9\n");
+  ASSERT_FALSE(r);
+  EXPECT_EQ(r.error().message, "line 5: face index 9 is out of range (3 vertices)");
+  auto z = io::parse_obj("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n");
+  ASSERT_FALSE(z);
+  EXPECT_NE(z.error().message.find("line 4"), std::string::npos);
+  auto neg = io::parse_obj("v 0 0 0\nv 1 0 0\nv 0 1 0\nf -1 -2 -4\n");
+  ASSERT_FALSE(neg);
+  EXPECT_NE(neg.error().message.find("out of range"), std::string::npos);
+}
+
+TEST(ObjErrors, BadNumbersAndEmptyMeshes) {
+  EXPECT_FALSE(io::parse_obj("v 0 0 nan\n"));
+  EXPECT_FALSE(io::parse_obj("v 0 0\nv 1 1 1\n"));  // coordinate missing on its line
+  EXPECT_FALSE(io::parse_obj("v 0 0 0\nf 1 1\n"));
+  auto none = io::parse_obj("v 0 0 0\nv 1 0 0\n");
+  ASSERT_FALSE(none);
+  EXPECT_EQ(none.error().status, Status::invalid_mesh);
+  EXPECT_FALSE(io::parse_obj(""));
+}
+
+const char* kTetraOff =
+    "OFF # a tetrahedron\n"
+    "# counts\n4 4 6\n"
+    "0 0 0\n1 0 0\n0 1 0\n0 0 1   # apex\n"
+    "3 0 2 1 255 0 0\n3 0 1 3\n3 1 2 3\n3 0 3 2\n";
+
+TEST(Off, ParsesCommentsAndFaceColours) {
+  auto r = io::parse_off(kTetraOff);
+  ASSERT_TRUE(r) << r.error().message;
+  EXPECT_EQ(r->faces.size(), 4u);
+  EXPECT_NEAR(signed_volume(*r), 1.0 / 6.0, 1e-12);
+}
+
+TEST(Off, CountsOnHeaderLineAndPolygons) {
+  auto r = io::parse_off("OFF 8 6 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n0 0 1\n1 0 1\n1 1 1\n0 1 1\n"
+                         "4 0 3 2 1\n4 4 5 6 7\n4 0 1 5 4\n4 1 2 6 5\n4 2 3 7 6\n4 3 0 4 7\n");
+  ASSERT_TRUE(r) << r.error().message;
+  EXPECT_EQ(r->faces.size(), 12u);
+  EXPECT_NEAR(signed_volume(*r), 1.0, 1e-12);
+}
+
+TEST(OffErrors, TruncatedLyingAndOutOfRange) {
+  auto t = io::parse_off("OFF\n4 4 6\n0 0 0\n1 0 0\n");
+  ASSERT_FALSE(t);
+  EXPECT_NE(t.error().message.find("after 2 of 4 vertices"), std::string::npos);
+  auto huge = io::parse_off("OFF\n2000000000 1 0\n0 0 0\n");
+  ASSERT_FALSE(huge);
+  EXPECT_NE(huge.error().message.find("exceed"), std::string::npos);
+  auto oor = io::parse_off("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n");
+  ASSERT_FALSE(oor);
+  EXPECT_NE(oor.error().message.find("line 6"), std::string::npos);
+  EXPECT_FALSE(io::parse_off("PLY\n"));
+  EXPECT_FALSE(io::parse_off("OFF\n3 1 0\n0 0 0\n1 x 0\n0 1 0\n3 0 1 2\n"));
+  EXPECT_FALSE(io::parse_off("OFF\n-3 1 0\n"));
+}
+
+}  // namespace
+}  // namespace nonplanar

@@ -1,0 +1,112 @@
+#include "support/solids.hpp"
+
+#include <unistd.h>
+
+#include <map>
+#include <utility>
+
+namespace nonplanar::test {
+
+TriangleMesh height_field_solid(const std::function<double(double, double)>& f, double x0,
+                                double x1, double y0, double y1, int nx, int ny, double base) {
+  TriangleMesh m;
+  const int cols = nx + 1, rows = ny + 1;
+  auto top = [&](int i, int j) { return j * cols + i; };
+  auto bot = [&](int i, int j) { return cols * rows + j * cols + i; };
+  for (int layer = 0; layer < 2; ++layer)
+    for (int j = 0; j < rows; ++j)
+      for (int i = 0; i < cols; ++i) {
+        const double x = x0 + (x1 - x0) * i / nx, y = y0 + (y1 - y0) * j / ny;
+        m.vertices.emplace_back(x, y, layer == 0 ? f(x, y) : base);
+      }
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i) {
+      // Top: counter-clockwise seen from above; bottom: the reverse.
+      m.faces.push_back({top(i, j), top(i + 1, j), top(i + 1, j + 1)});
+      m.faces.push_back({top(i, j), top(i + 1, j + 1), top(i, j + 1)});
+      m.faces.push_back({bot(i, j), bot(i + 1, j + 1), bot(i + 1, j)});
+      m.faces.push_back({bot(i, j), bot(i, j + 1), bot(i + 1, j + 1)});
+    }
+  auto wall = [&](int a_top, int b_top, int a_bot, int b_bot) {  // a→b runs counter-clockwise
+    m.faces.push_back({a_bot, b_bot, b_top});
+    m.faces.push_back({a_bot, b_top, a_top});
+  };
+  for (int i = 0; i < nx; ++i) {
+    wall(top(i, 0), top(i + 1, 0), bot(i, 0), bot(i + 1, 0));              // y = y0 side
+    wall(top(i + 1, ny), top(i, ny), bot(i + 1, ny), bot(i, ny));          // y = y1 side
+  }
+  for (int j = 0; j < ny; ++j) {
+    wall(top(nx, j), top(nx, j + 1), bot(nx, j), bot(nx, j + 1));          // x = x1 side
+    wall(top(0, j + 1), top(0, j), bot(0, j + 1), bot(0, j));              // x = x0 side
+  }
+  return m;
+}
+
+TriangleMesh box(const Vec3& lo, const Vec3& hi) {
+  return height_field_solid([&](double, double) { return hi.z(); }, lo.x(), hi.x(), lo.y(),
+                            hi.y(), 1, 1, lo.z());
+}
+
+TriangleMesh subdivide(const TriangleMesh& in, int levels) {
+  TriangleMesh m = in;
+  for (int l = 0; l < levels; ++l) {
+    TriangleMesh next;
+    next.vertices = m.vertices;
+    std::map<std::pair<int, int>, int> mid;
+    auto midpoint = [&](int a, int b) {
+      const auto key = std::minmax(a, b);
+      auto it = mid.find(key);
+      if (it != mid.end()) return it->second;
+      next.vertices.push_back(0.5 * (m.vertices[a] + m.vertices[b]));
+      const int id = static_cast<int>(next.vertices.size()) - 1;
+      mid.emplace(key, id);
+      return id;
+    };
+    for (const auto& f : m.faces) {
+      const int ab = midpoint(f[0], f[1]), bc = midpoint(f[1], f[2]), ca = midpoint(f[2], f[0]);
+      next.faces.push_back({f[0], ab, ca});
+      next.faces.push_back({ab, f[1], bc});
+      next.faces.push_back({ca, bc, f[2]});
+      next.faces.push_back({ab, bc, ca});
+    }
+    m = std::move(next);
+  }
+  return m;
+}
+
+TriangleMesh icosphere(const Vec3& c, double r, int levels) {
+  const double t = (1.0 + std::sqrt(5.0)) / 2.0;
+  TriangleMesh m;
+  m.vertices = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
+                {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
+  m.faces = {{0, 11, 5}, {0, 5, 1}, {0, 1, 7},  {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
+             {11, 10, 2}, {10, 7, 6}, {7, 1, 8}, {3, 9, 4}, {3, 4, 2},  {3, 2, 6}, {3, 6, 8},
+             {3, 8, 9},  {4, 9, 5},  {2, 4, 11}, {6, 2, 10}, {8, 6, 7}, {9, 8, 1}};
+  m = subdivide(m, levels);
+  for (Vec3& v : m.vertices) v = c + r * v.normalized();
+  return m;
+}
+
+void append(TriangleMesh& a, const TriangleMesh& b) {
+  const int base = static_cast<int>(a.vertices.size());
+  a.vertices.insert(a.vertices.end(), b.vertices.begin(), b.vertices.end());
+  for (auto f : b.faces) a.faces.push_back({f[0] + base, f[1] + base, f[2] + base});
+}
+
+std::filesystem::path shared_models() {
+  const std::filesystem::path p = NONPLANAR_SHARED_MODELS;
+  return std::filesystem::is_directory(p) ? p : std::filesystem::path();
+}
+
+std::filesystem::path temp_dir(const std::string& name) {
+  // Unique per process and call: ctest runs tests in parallel processes.
+  static int counter = 0;
+  const auto p = std::filesystem::temp_directory_path() /
+                 ("nonplanar_test_" + name + "_" + std::to_string(::getpid()) + "_" +
+                  std::to_string(counter++));
+  std::filesystem::remove_all(p);
+  std::filesystem::create_directories(p);
+  return p;
+}
+
+}  // namespace nonplanar::test
