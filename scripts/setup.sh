@@ -13,7 +13,7 @@ pkgs=(
   libeigen3-dev libceres-dev libtbb-dev libpolyclipping-dev lib3mf-dev
   libcli11-dev nlohmann-json3-dev libfmt-dev libspdlog-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  zip unzip
+  zip unzip time
 )
 if [[ "${1:-}" == "--with-prusaslicer" ]]; then
   pkgs+=(prusa-slicer)

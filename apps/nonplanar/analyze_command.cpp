@@ -25,12 +25,24 @@ unsigned patch_color(int i) {
   const double x = 1.0 - std::abs(std::fmod(h, 2.0) - 1.0);
   double r = 0, g = 0, b = 0;
   switch (static_cast<int>(h)) {
-    case 0: r = 1, g = x; break;
-    case 1: r = x, g = 1; break;
-    case 2: g = 1, b = x; break;
-    case 3: g = x, b = 1; break;
-    case 4: r = x, b = 1; break;
-    default: r = 1, b = x; break;
+    case 0:
+      r = 1, g = x;
+      break;
+    case 1:
+      r = x, g = 1;
+      break;
+    case 2:
+      g = 1, b = x;
+      break;
+    case 3:
+      g = x, b = 1;
+      break;
+    case 4:
+      r = x, b = 1;
+      break;
+    default:
+      r = 1, b = x;
+      break;
   }
   auto c = [](double v) { return static_cast<unsigned>(60 + 195 * v); };
   return (c(r) << 16) | (c(g) << 8) | c(b);
@@ -96,9 +108,10 @@ void print_text(const AnalyzeOptions& o, const LoadedMesh& m, const Analysis& a)
   std::printf("%s (%s): %zu triangles, %zu vertices, %zu shell%s, %s\n", o.mesh.model.c_str(),
               format_name(m.format), m.mesh.faces.size(), m.mesh.vertices.size(), d.shells,
               d.shells == 1 ? "" : "s", d.closed() ? "closed" : "NOT closed");
-  std::printf("size %.2f x %.2f x %.2f mm, volume %.1f mm^3, placed with centre (%.1f, %.1f), z from 0\n",
-              box.size().x(), box.size().y(), box.size().z(), signed_volume(m.mesh),
-              o.mesh.load.bed_center.x(), o.mesh.load.bed_center.y());
+  std::printf(
+      "size %.2f x %.2f x %.2f mm, volume %.1f mm^3, placed with centre (%.1f, %.1f), z from 0\n",
+      box.size().x(), box.size().y(), box.size().z(), signed_volume(m.mesh),
+      o.mesh.load.bed_center.x(), o.mesh.load.bed_center.y());
   std::printf("painted faces (slope < %.1f deg): %zu of %zu; discontinuous %zu; crease edges %zu\n",
               o.params.max_angle_deg, a.painted_faces, m.mesh.faces.size(), a.discontinuous_faces,
               a.crease_edges);

@@ -36,7 +36,8 @@ int report_error(const Error& e) {
 
 void report_warnings(const std::string& file, const LoadedMesh& m, bool quiet) {
   if (quiet) return;
-  for (const auto& w : m.warnings) std::fprintf(stderr, "warning: %s: %s\n", file.c_str(), w.c_str());
+  for (const auto& w : m.warnings)
+    std::fprintf(stderr, "warning: %s: %s\n", file.c_str(), w.c_str());
 }
 
 Context make_context(bool quiet) {

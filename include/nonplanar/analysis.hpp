@@ -16,7 +16,7 @@ namespace nonplanar {
 
 /// Inputs of analyze(). Degrees and millimetres.
 struct AnalysisParams {
-  double max_angle_deg = 30.0;     ///< a face is printable non-planar when θ_f < max_angle
+  double max_angle_deg = 30.0;  ///< a face is printable non-planar when θ_f < max_angle
   /// Vertex discontinuous when K̂(v) > tau (1/mm²): sharper than a sphere of radius
   /// 1/√tau ≈ 3 mm, which a fitted surface would round off visibly.
   double tau = 0.1;
@@ -32,8 +32,8 @@ const char* verdict_name(PatchVerdict v);
 
 /// A connected set of painted faces with no discontinuity or crease inside.
 struct Patch {
-  std::vector<int> faces;   ///< face indices into the analysed mesh
-  double area = 0.0;        ///< mm²
+  std::vector<int> faces;  ///< face indices into the analysed mesh
+  double area = 0.0;       ///< mm²
   Vec2 xy_min{0, 0}, xy_max{0, 0};
   double z_min = 0.0, z_max = 0.0;
   double max_slope_deg = 0.0;  ///< steepest face θ_f in the patch
@@ -48,9 +48,9 @@ struct Analysis {
   std::vector<char> discontinuous;  ///< F flags: painted face touching a discontinuous vertex
   std::size_t painted_faces = 0;
   std::size_t discontinuous_faces = 0;
-  std::size_t crease_edges = 0;     ///< painted–painted edges sharper than crease_angle
-  std::vector<Patch> patches;       ///< sorted by decreasing area
-  std::vector<int> face_patch;      ///< F entries: patch index or −1
+  std::size_t crease_edges = 0;  ///< painted–painted edges sharper than crease_angle
+  std::vector<Patch> patches;    ///< sorted by decreasing area
+  std::vector<int> face_patch;   ///< F entries: patch index or −1
 };
 
 /// Run facet selection, curvature, discontinuity and crease detection and patch extraction

@@ -16,11 +16,11 @@ const char* format_name(MeshFormat f);
 
 /// Inputs of load_mesh. Angles in degrees, lengths in mm.
 struct LoadParams {
-  double scale = 1.0;           ///< uniform scale applied first (must be finite and > 0)
-  double rotate_x_deg = 0.0;    ///< then rotations about X, Y, Z, in that order
+  double scale = 1.0;         ///< uniform scale applied first (must be finite and > 0)
+  double rotate_x_deg = 0.0;  ///< then rotations about X, Y, Z, in that order
   double rotate_y_deg = 0.0;
   double rotate_z_deg = 0.0;
-  bool place_on_bed = true;     ///< XY bbox centre at bed_center, lowest point at z = 0
+  bool place_on_bed = true;  ///< XY bbox centre at bed_center, lowest point at z = 0
   Vec2 bed_center{110.0, 110.0};
   /// Weld tolerance as a fraction of the bounding-box diagonal (1e-7 of 100 mm = 0.01 µm
   /// would be too tight for float STL noise; 1e-6 closes near-coincident vertices safely).
@@ -34,8 +34,8 @@ struct LoadedMesh {
   MeshDefects defects;
   MeshFormat format = MeshFormat::stl_binary;
   std::size_t input_triangles = 0;
-  double weld_tolerance = 0.0;           ///< absolute, mm
-  std::vector<std::string> warnings;     ///< one line each, without the file name
+  double weld_tolerance = 0.0;        ///< absolute, mm
+  std::vector<std::string> warnings;  ///< one line each, without the file name
 };
 
 /// Read, weld, orient and place a mesh. The format is chosen by extension (.stl .obj .off

@@ -11,9 +11,12 @@ namespace nonplanar {
 
 const char* verdict_name(PatchVerdict v) {
   switch (v) {
-    case PatchVerdict::nonplanar: return "non-planar";
-    case PatchVerdict::flat: return "flat";
-    case PatchVerdict::too_small: return "too small";
+    case PatchVerdict::nonplanar:
+      return "non-planar";
+    case PatchVerdict::flat:
+      return "flat";
+    case PatchVerdict::too_small:
+      return "too small";
   }
   return "unknown";
 }
@@ -27,7 +30,8 @@ std::optional<Error> check_params(const AnalysisParams& p) {
   if (!std::isfinite(p.max_angle_deg) || p.max_angle_deg <= 0 || p.max_angle_deg >= 90)
     return bad("max_angle", "must be in (0, 90) degrees");
   if (!std::isfinite(p.tau) || p.tau < 0) return bad("tau", "must be a finite number >= 0");
-  if (!std::isfinite(p.epsilon) || p.epsilon < 0) return bad("epsilon", "must be a finite number >= 0");
+  if (!std::isfinite(p.epsilon) || p.epsilon < 0)
+    return bad("epsilon", "must be a finite number >= 0");
   if (!std::isfinite(p.crease_angle_deg) || p.crease_angle_deg <= 0 || p.crease_angle_deg >= 180)
     return bad("crease_angle", "must be in (0, 180) degrees");
   if (!std::isfinite(p.min_layer_height) || p.min_layer_height <= 0)

@@ -33,35 +33,35 @@ VertexCurvature angle_deficit(const TriangleMesh& mesh, const MeshTopology& topo
   c.boundary.assign(nv, 0);
   auto in = [&](int f) { return f >= 0 && (!mask || (*mask)[f]); };
   // Gather per vertex over its faces: no two threads write the same vertex.
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nv, 4096),
-                    [&](const tbb::blocked_range<std::size_t>& r) {
-                      for (std::size_t v = r.begin(); v != r.end(); ++v) {
-                        double theta = 0.0, area = 0.0;
-                        bool touched = false, boundary = false;
-                        for (int i = topo.vertex_face_offsets[v]; i < topo.vertex_face_offsets[v + 1]; ++i) {
-                          const int f = topo.vertex_faces[i];
-                          if (!in(f)) continue;
-                          touched = true;
-                          const auto& tri = mesh.faces[f];
-                          const int k = tri[0] == static_cast<int>(v) ? 0 : tri[1] == static_cast<int>(v) ? 1 : 2;
-                          theta += corner_angle(mesh, tri, k);
-                          area += geom.areas[f] / 3.0;
-                          // The two edges of f at v: corner k (v → next) and corner k+2 (prev → v).
-                          if (!in(topo.across[3 * f + k]) || !in(topo.across[3 * f + (k + 2) % 3]))
-                            boundary = true;
-                        }
-                        if (!touched) continue;
-                        c.boundary[v] = boundary;
-                        c.deficit[v] = (boundary ? M_PI : 2.0 * M_PI) - theta;
-                        c.area[v] = area;
-                      }
-                    });
+  tbb::parallel_for(
+      tbb::blocked_range<std::size_t>(0, nv, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t v = r.begin(); v != r.end(); ++v) {
+          double theta = 0.0, area = 0.0;
+          bool touched = false, boundary = false;
+          for (int i = topo.vertex_face_offsets[v]; i < topo.vertex_face_offsets[v + 1]; ++i) {
+            const int f = topo.vertex_faces[i];
+            if (!in(f)) continue;
+            touched = true;
+            const auto& tri = mesh.faces[f];
+            const int k = tri[0] == static_cast<int>(v) ? 0 : tri[1] == static_cast<int>(v) ? 1 : 2;
+            theta += corner_angle(mesh, tri, k);
+            area += geom.areas[f] / 3.0;
+            // The two edges of f at v: corner k (v → next) and corner k+2 (prev → v).
+            if (!in(topo.across[3 * f + k]) || !in(topo.across[3 * f + (k + 2) % 3]))
+              boundary = true;
+          }
+          if (!touched) continue;
+          c.boundary[v] = boundary;
+          c.deficit[v] = (boundary ? M_PI : 2.0 * M_PI) - theta;
+          c.area[v] = area;
+        }
+      });
   return c;
 }
 
 std::vector<char> discontinuous_vertices(const TriangleMesh& mesh, const VertexCurvature& curv,
-                                         const std::vector<char>& mask,
-                                         double tau, double epsilon) {
+                                         const std::vector<char>& mask, double tau,
+                                         double epsilon) {
   const std::vector<double> k = curv.normalized();
   std::vector<char> out(mesh.vertices.size(), 0);
   auto interior = [&](int v) { return curv.area[v] > 0 && !curv.boundary[v]; };

@@ -31,7 +31,6 @@ VertexCurvature angle_deficit(const TriangleMesh& mesh, const MeshTopology& topo
 /// boundary, π − Θ measures how the outline turns, not how the surface bends.
 /// Returns V flags.
 std::vector<char> discontinuous_vertices(const TriangleMesh& mesh, const VertexCurvature& curv,
-                                         const std::vector<char>& mask,
-                                         double tau, double epsilon);
+                                         const std::vector<char>& mask, double tau, double epsilon);
 
 }  // namespace nonplanar::analysis

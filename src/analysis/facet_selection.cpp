@@ -4,14 +4,16 @@
 
 #include <cmath>
 
+#include "core/huge_pages.hpp"
+
 namespace nonplanar::analysis {
 
 FaceGeometry face_geometry(const TriangleMesh& mesh) {
   const std::size_t nf = mesh.faces.size();
   FaceGeometry g;
-  g.normals.resize(nf);
-  g.areas.resize(nf);
-  g.degenerate.resize(nf);
+  assign_huge(g.normals, nf, Vec3(Vec3::Zero()));
+  assign_huge(g.areas, nf, 0.0);
+  assign_huge(g.degenerate, nf, char{0});
   const double diag = bounding_box(mesh).size().norm();
   const double min_area = (1e-9 * diag) * (1e-9 * diag);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nf, 8192),

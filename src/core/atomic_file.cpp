@@ -19,13 +19,13 @@ Expected<bool> write_file_atomically(const std::filesystem::path& file,
     return Error{Status::io_error, file.string() + ": folder does not exist"};
   // Hidden, unique temporary in the same folder so the rename is atomic (same filesystem).
   std::random_device rd;
-  const fs::path tmp =
-      dir / ("." + file.filename().string() + ".tmp" + std::to_string(::getpid()) + "_" +
-             std::to_string(rd() & 0xffffff));
+  const fs::path tmp = dir / ("." + file.filename().string() + ".tmp" + std::to_string(::getpid()) +
+                              "_" + std::to_string(rd() & 0xffffff));
   bool ok = false;
   {
     std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) return Error{Status::io_error, file.string() + ": cannot write: " + std::strerror(errno)};
+    if (!out)
+      return Error{Status::io_error, file.string() + ": cannot write: " + std::strerror(errno)};
     ok = write(out);
     out.flush();
     ok = ok && out.good();
@@ -37,7 +37,8 @@ Expected<bool> write_file_atomically(const std::filesystem::path& file,
   fs::rename(tmp, file, ec);
   if (ec) {
     fs::remove(tmp, ec);
-    return Error{Status::io_error, file.string() + ": cannot rename temporary file: " + ec.message()};
+    return Error{Status::io_error,
+                 file.string() + ": cannot rename temporary file: " + ec.message()};
   }
   return true;
 }

@@ -1,5 +1,7 @@
 #include "core/mesh_topology.hpp"
 
+#include "core/huge_pages.hpp"
+
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
@@ -28,20 +30,20 @@ MeshTopology build_topology(const TriangleMesh& mesh) {
   MeshTopology t;
   const int nv = static_cast<int>(mesh.vertices.size());
   const int nf = static_cast<int>(mesh.faces.size());
-  t.vertex_face_offsets.assign(nv + 1, 0);
+  assign_huge(t.vertex_face_offsets, nv + 1, 0);
   for (const auto& f : mesh.faces)
     for (int k = 0; k < 3; ++k) ++t.vertex_face_offsets[f[k] + 1];
   std::partial_sum(t.vertex_face_offsets.begin(), t.vertex_face_offsets.end(),
                    t.vertex_face_offsets.begin());
-  t.vertex_faces.resize(t.vertex_face_offsets.back());
+  assign_huge(t.vertex_faces, t.vertex_face_offsets.back(), 0);
   {
     std::vector<int> fill(t.vertex_face_offsets.begin(), t.vertex_face_offsets.end() - 1);
     for (int fi = 0; fi < nf; ++fi)
       for (int k = 0; k < 3; ++k) t.vertex_faces[fill[mesh.faces[fi][k]]++] = fi;
   }
 
-  t.across.assign(3 * static_cast<std::size_t>(nf), MeshTopology::kOpen);
-  t.same_direction.assign(3 * static_cast<std::size_t>(nf), 0);
+  assign_huge(t.across, 3 * static_cast<std::size_t>(nf), MeshTopology::kOpen);
+  assign_huge(t.same_direction, 3 * static_cast<std::size_t>(nf), char{0});
   std::atomic<std::size_t> open{0}, nonman{0}, incons{0};
   tbb::parallel_for(tbb::blocked_range<int>(0, nf, 4096), [&](const tbb::blocked_range<int>& r) {
     std::size_t l_open = 0, l_nonman = 0, l_incons = 0;

@@ -6,25 +6,38 @@ namespace nonplanar {
 
 const char* status_name(Status s) {
   switch (s) {
-    case Status::ok: return "ok";
-    case Status::invalid_argument: return "invalid argument";
-    case Status::io_error: return "i/o error";
-    case Status::parse_error: return "parse error";
-    case Status::invalid_mesh: return "invalid mesh";
-    case Status::cancelled: return "cancelled";
-    case Status::unsupported: return "unsupported";
-    case Status::internal_error: return "internal error";
+    case Status::ok:
+      return "ok";
+    case Status::invalid_argument:
+      return "invalid argument";
+    case Status::io_error:
+      return "i/o error";
+    case Status::parse_error:
+      return "parse error";
+    case Status::invalid_mesh:
+      return "invalid mesh";
+    case Status::cancelled:
+      return "cancelled";
+    case Status::unsupported:
+      return "unsupported";
+    case Status::internal_error:
+      return "internal error";
   }
   return "unknown";
 }
 
 const char* format_name(MeshFormat f) {
   switch (f) {
-    case MeshFormat::stl_binary: return "binary STL";
-    case MeshFormat::stl_ascii: return "ASCII STL";
-    case MeshFormat::obj: return "OBJ";
-    case MeshFormat::off: return "OFF";
-    case MeshFormat::threemf: return "3MF";
+    case MeshFormat::stl_binary:
+      return "binary STL";
+    case MeshFormat::stl_ascii:
+      return "ASCII STL";
+    case MeshFormat::obj:
+      return "OBJ";
+    case MeshFormat::off:
+      return "OFF";
+    case MeshFormat::threemf:
+      return "3MF";
   }
   return "unknown";
 }

@@ -1,33 +1,60 @@
 #include "io/mesh_buffer.hpp"
 
+#include <fcntl.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <cerrno>
 #include <charconv>
 #include <cmath>
 #include <cstring>
-#include <fstream>
 #include <system_error>
 
 namespace nonplanar::io {
 
-Expected<std::string> read_file_bytes(const std::filesystem::path& file, std::size_t max_bytes) {
-  namespace fs = std::filesystem;
-  std::error_code ec;
-  const auto status = fs::status(file, ec);
-  if (ec || !fs::exists(status)) return Error{Status::io_error, "file not found"};
-  if (fs::is_directory(status)) return Error{Status::io_error, "is a folder, not a file"};
-  std::ifstream in(file, std::ios::binary);
-  if (!in) return Error{Status::io_error, std::string("cannot open: ") + std::strerror(errno)};
-  in.seekg(0, std::ios::end);
-  const std::streamoff size = in.tellg();
-  if (size < 0) return Error{Status::io_error, "cannot determine the file size"};
-  if (static_cast<std::size_t>(size) > max_bytes)
+FileBytes& FileBytes::operator=(FileBytes&& o) noexcept {
+  if (this != &o) {
+    this->~FileBytes();
+    data_ = o.data_;
+    size_ = o.size_;
+    o.data_ = nullptr;
+  }
+  return *this;
+}
+
+FileBytes::~FileBytes() {
+  if (data_) ::munmap(const_cast<void*>(data_), size_);
+}
+
+Expected<FileBytes> read_file_bytes(const std::filesystem::path& file, std::size_t max_bytes) {
+  const int fd = ::open(file.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0)
+    return Error{Status::io_error, errno == ENOENT
+                                       ? std::string("file not found")
+                                       : std::string("cannot open: ") + std::strerror(errno)};
+  struct stat st {};
+  if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+    ::close(fd);
+    return Error{Status::io_error,
+                 S_ISDIR(st.st_mode) ? "is a folder, not a file" : "not a regular file"};
+  }
+  const auto size = static_cast<std::size_t>(st.st_size);
+  if (size > max_bytes) {
+    ::close(fd);
     return Error{Status::invalid_mesh, "file is " + std::to_string(size) +
                                            " bytes, over the limit of " +
                                            std::to_string(max_bytes)};
-  in.seekg(0);
-  std::string data(static_cast<std::size_t>(size), '\0');
-  if (size > 0 && !in.read(data.data(), size)) return Error{Status::io_error, "read failed"};
-  return data;
+  }
+  if (size == 0) {
+    ::close(fd);
+    return FileBytes();
+  }
+  void* p = ::mmap(nullptr, size, PROT_READ, MAP_PRIVATE | MAP_POPULATE, fd, 0);
+  ::close(fd);
+  if (p == MAP_FAILED)
+    return Error{Status::io_error, std::string("cannot read: ") + std::strerror(errno)};
+  return FileBytes(p, size);
 }
 
 std::optional<double> parse_double(std::string_view t) {

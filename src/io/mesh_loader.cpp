@@ -35,7 +35,8 @@ std::optional<Error> check_params(const LoadParams& p) {
       !std::isfinite(p.rotate_z_deg))
     return bad("rotate", "angles must be finite");
   if (!p.bed_center.allFinite()) return bad("bed_center", "must be finite");
-  if (!std::isfinite(p.weld_tolerance_rel) || p.weld_tolerance_rel < 0 || p.weld_tolerance_rel > 1e-2)
+  if (!std::isfinite(p.weld_tolerance_rel) || p.weld_tolerance_rel < 0 ||
+      p.weld_tolerance_rel > 1e-2)
     return bad("weld_tolerance_rel", "must be in [0, 0.01]");
   return std::nullopt;
 }
@@ -47,8 +48,8 @@ Expected<LoadedMesh> load_mesh(const std::filesystem::path& file, const LoadPara
   if (auto e = check_params(params)) return *e;
   const std::string ext = lower_extension(file);
   if (ext != ".stl" && ext != ".obj" && ext != ".off" && ext != ".3mf")
-    return Error{Status::unsupported,
-                 file.string() + ": unknown mesh format '" + ext + "' (use .stl, .obj, .off or .3mf)"};
+    return Error{Status::unsupported, file.string() + ": unknown mesh format '" + ext +
+                                          "' (use .stl, .obj, .off or .3mf)"};
   // 50 bytes per binary STL triangle bounds any reasonable file for max_triangles.
   auto bytes = io::read_file_bytes(file, 64 + params.max_triangles * 200);
   if (!bytes) return with_file(file, bytes.error());
@@ -56,26 +57,26 @@ Expected<LoadedMesh> load_mesh(const std::filesystem::path& file, const LoadPara
 
   LoadedMesh out;
   Expected<TriangleMesh> raw = Error{};
+  const std::string_view data = bytes->view();
   if (ext == ".stl") {
-    raw = io::parse_stl(*bytes, &out.format);
+    raw = io::parse_stl(data, &out.format);
   } else if (ext == ".obj") {
     out.format = MeshFormat::obj;
-    raw = io::parse_obj(*bytes);
+    raw = io::parse_obj(data);
   } else if (ext == ".off") {
     out.format = MeshFormat::off;
-    raw = io::parse_off(*bytes);
+    raw = io::parse_off(data);
   } else {
     out.format = MeshFormat::threemf;
-    raw = io::parse_3mf(*bytes);
+    raw = io::parse_3mf(data);
   }
-  bytes->clear();
-  bytes->shrink_to_fit();
+  *bytes = io::FileBytes();  // unmap
   if (!raw) return with_file(file, raw.error());
   if (raw->faces.empty()) return with_file(file, {Status::invalid_mesh, "mesh has no triangles"});
   if (raw->faces.size() > params.max_triangles)
-    return with_file(file, {Status::invalid_mesh,
-                            std::to_string(raw->faces.size()) + " triangles, over the limit of " +
-                                std::to_string(params.max_triangles)});
+    return with_file(file, {Status::invalid_mesh, std::to_string(raw->faces.size()) +
+                                                      " triangles, over the limit of " +
+                                                      std::to_string(params.max_triangles)});
   if (auto e = io::check_face_indices(*raw)) return with_file(file, *e);
   for (const Vec3& v : raw->vertices)
     if (v.cwiseAbs().maxCoeff() > kMaxCoordinate)
@@ -86,8 +87,8 @@ Expected<LoadedMesh> load_mesh(const std::filesystem::path& file, const LoadPara
   out.input_triangles = raw->faces.size();
   const BoundingBox raw_box = bounding_box(*raw);
   out.weld_tolerance = params.weld_tolerance_rel * raw_box.size().norm();
-  out.mesh = io::weld(*raw, out.weld_tolerance, &out.defects.collapsed_faces);
-  raw = Error{};  // free the soup
+  out.mesh = io::weld(std::move(*raw), out.weld_tolerance, &out.defects.collapsed_faces);
+  raw = Error{};
   if (out.mesh.faces.empty())
     return with_file(file, {Status::invalid_mesh, "every triangle is degenerate"});
   out.weld_tolerance *= params.scale;
@@ -105,16 +106,19 @@ Expected<LoadedMesh> load_mesh(const std::filesystem::path& file, const LoadPara
   out.defects.faces_flipped = io::orient_outward(out.mesh, topo, &out.defects.was_inverted);
 
   const MeshDefects& d = out.defects;
-  if (d.open_edges) out.warnings.push_back(std::to_string(d.open_edges) + " open edges (mesh has holes)");
+  if (d.open_edges)
+    out.warnings.push_back(std::to_string(d.open_edges) + " open edges (mesh has holes)");
   if (d.non_manifold_edges)
     out.warnings.push_back(std::to_string(d.non_manifold_edges) + " non-manifold edges");
   if (d.inconsistent_edges)
     out.warnings.push_back(std::to_string(d.inconsistent_edges) +
                            " edges with inconsistent winding (faces reoriented)");
   if (d.was_inverted) out.warnings.push_back("mesh was inside out (normals flipped)");
-  if (d.zero_area_faces) out.warnings.push_back(std::to_string(d.zero_area_faces) + " zero-area faces");
+  if (d.zero_area_faces)
+    out.warnings.push_back(std::to_string(d.zero_area_faces) + " zero-area faces");
   if (d.collapsed_faces)
-    out.warnings.push_back(std::to_string(d.collapsed_faces) + " degenerate faces removed by welding");
+    out.warnings.push_back(std::to_string(d.collapsed_faces) +
+                           " degenerate faces removed by welding");
   ctx.progress("load", 1.0);
   return out;
 }

@@ -45,8 +45,8 @@ Expected<TriangleMesh> parse_obj(std::string_view data) {
       }
       if (poly.size() < 3) return parse_error_at(line, "face has fewer than 3 vertices");
       for (std::size_t k = 1; k + 1 < poly.size(); ++k) {
-        mesh.faces.push_back({static_cast<int>(poly[0]), static_cast<int>(poly[k]),
-                              static_cast<int>(poly[k + 1])});
+        mesh.faces.push_back(
+            {static_cast<int>(poly[0]), static_cast<int>(poly[k]), static_cast<int>(poly[k + 1])});
         face_lines.push_back(line);
       }
     } else {

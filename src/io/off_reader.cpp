@@ -44,7 +44,8 @@ Expected<TriangleMesh> parse_off(std::string_view data) {
   if (!nv || !nf || *nv < 0 || *nf < 0)
     return parse_error_at(line, "vertex and face counts must be non-negative integers");
   // Every record needs at least a few bytes; larger counts mean a truncated or lying header.
-  if (*nv > static_cast<long long>(data.size()) / 2 || *nf > static_cast<long long>(data.size()) / 2)
+  if (*nv > static_cast<long long>(data.size()) / 2 ||
+      *nf > static_cast<long long>(data.size()) / 2)
     return parse_error_at(line, "counts (" + std::to_string(*nv) + " vertices, " +
                                     std::to_string(*nf) + " faces) exceed what the file holds");
   if (*nf == 0) return Error{Status::invalid_mesh, "OFF file has no faces"};
@@ -68,8 +69,8 @@ Expected<TriangleMesh> parse_off(std::string_view data) {
   }
   for (long long i = 0; i < *nf; ++i) {
     if (!next_record(tok, rec, &line))
-      return parse_error_at(line, "file ends after " + std::to_string(i) + " of " +
-                                      std::to_string(*nf) + " faces");
+      return parse_error_at(
+          line, "file ends after " + std::to_string(i) + " of " + std::to_string(*nf) + " faces");
     const auto n = parse_int(rec[0]);
     if (!n || *n < 3 || static_cast<std::size_t>(*n) + 1 > rec.size())
       return parse_error_at(line, "face needs a vertex count of at least 3 and that many indices");

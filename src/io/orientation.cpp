@@ -6,7 +6,9 @@
 namespace nonplanar::io {
 namespace {
 
-void flip(std::array<int, 3>& f) { std::swap(f[1], f[2]); }
+void flip(std::array<int, 3>& f) {
+  std::swap(f[1], f[2]);
+}
 
 }  // namespace
 

@@ -12,7 +12,7 @@ namespace nonplanar::io {
 /// merge (their count goes to *collapsed). Unreferenced vertices are removed.
 /// Exact duplicates are merged by hashing first, so only unique points meet the slower
 /// tolerant grid search; O(V) expected.
-TriangleMesh weld(const TriangleMesh& raw, double tolerance, std::size_t* collapsed);
+TriangleMesh weld(TriangleMesh mesh, double tolerance, std::size_t* collapsed);
 
 /// Faces whose height over their longest edge is below `tolerance` (needles and caps).
 std::size_t count_zero_area_faces(const TriangleMesh& mesh, double tolerance);

@@ -1,7 +1,10 @@
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <vector>
 
+#include "core/huge_pages.hpp"
 #include "io/mesh_buffer.hpp"
 #include "io/readers.hpp"
 
@@ -13,30 +16,81 @@ constexpr std::size_t kRecord = 50;  // normal, 3 vertices (12 floats) + uint16 
 
 bool starts_with_solid(std::string_view data) {
   std::size_t i = 0;
-  while (i < data.size() && (data[i] == ' ' || data[i] == '\t' || data[i] == '\r' ||
-                             data[i] == '\n'))
+  while (i < data.size() &&
+         (data[i] == ' ' || data[i] == '\t' || data[i] == '\r' || data[i] == '\n'))
     ++i;
   return data.substr(i, 5) == "solid";
 }
 
+// Exact-duplicate index of float triples, growing as needed. A binary STL repeats every
+// shared vertex bit for bit, so merging them while parsing keeps ~1/6 of the corners and
+// never materialises the triangle soup.
+class FloatPointIndex {
+ public:
+  explicit FloatPointIndex(std::size_t expected) {
+    reserve_huge(points_, expected);
+    rehash(expected);
+  }
+  int insert(const float* p) {
+    if (2 * (points_.size() + 1) > slots_.size()) rehash(2 * slots_.size());
+    for (std::size_t i = hash(p) & mask_;; i = (i + 1) & mask_) {
+      const int s = slots_[i];
+      if (s < 0) {
+        slots_[i] = static_cast<int>(points_.size());
+        points_.push_back({p[0], p[1], p[2]});
+        return slots_[i];
+      }
+      if (std::memcmp(points_[s].data(), p, 12) == 0) return s;
+    }
+  }
+  const std::vector<std::array<float, 3>>& points() const { return points_; }
+
+ private:
+  static std::size_t hash(const float* p) {
+    std::uint32_t b[3];
+    std::memcpy(b, p, 12);
+    std::uint64_t h = (std::uint64_t{b[0]} << 32 | b[1]) * 0x9E3779B97F4A7C15ULL;
+    h ^= (h >> 29) ^ (std::uint64_t{b[2]} * 0xbf58476d1ce4e5b9ULL);
+    return static_cast<std::size_t>(h ^ (h >> 32));
+  }
+  void rehash(std::size_t n) {
+    std::size_t cap = 64;
+    while (cap < 2 * n) cap <<= 1;
+    assign_huge(slots_, cap, -1);
+    mask_ = cap - 1;
+    for (std::size_t s = 0; s < points_.size(); ++s) {
+      std::size_t i = hash(points_[s].data()) & mask_;
+      while (slots_[i] >= 0) i = (i + 1) & mask_;
+      slots_[i] = static_cast<int>(s);
+    }
+  }
+  std::vector<int> slots_;
+  std::size_t mask_ = 0;
+  std::vector<std::array<float, 3>> points_;
+};
+
 Expected<TriangleMesh> parse_binary(std::string_view data, std::uint32_t count) {
   TriangleMesh mesh;
-  mesh.vertices.resize(3 * static_cast<std::size_t>(count));
+  reserve_huge(mesh.faces, count);
   mesh.faces.resize(count);
+  FloatPointIndex index(count / 2 + 16);  // a closed mesh has about half as many vertices
   const char* p = data.data() + kHeader;
   for (std::uint32_t t = 0; t < count; ++t, p += kRecord) {
     float f[9];
     std::memcpy(f, p + 12, sizeof f);  // skip the stored normal: it is often zero or wrong
-    for (int k = 0; k < 3; ++k) {
-      const Vec3 v(f[3 * k], f[3 * k + 1], f[3 * k + 2]);
-      if (!v.allFinite())
+    for (int k = 0; k < 9; ++k)
+      if (!std::isfinite(f[k]))
         return Error{Status::parse_error,
                      "triangle " + std::to_string(t + 1) + ": coordinate is not a finite number"};
-      mesh.vertices[3 * static_cast<std::size_t>(t) + k] = v;
+    for (int k = 0; k < 3; ++k) {
+      if (f[3 * k] == 0.0f) f[3 * k] = 0.0f;  // fold -0 into +0 so the bits compare equal
+      if (f[3 * k + 1] == 0.0f) f[3 * k + 1] = 0.0f;
+      if (f[3 * k + 2] == 0.0f) f[3 * k + 2] = 0.0f;
+      mesh.faces[t][k] = index.insert(f + 3 * k);
     }
-    const int b = static_cast<int>(3 * t);
-    mesh.faces[t] = {b, b + 1, b + 2};
   }
+  reserve_huge(mesh.vertices, index.points().size());
+  for (const auto& q : index.points()) mesh.vertices.emplace_back(q[0], q[1], q[2]);
   return mesh;
 }
 

@@ -158,8 +158,7 @@ Expected<bool> write_3mf(const std::filesystem::path& file, const TriangleMesh& 
     return Error{Status::internal_error, file.string() + ": cannot create a 3MF model"};
   std::vector<NMR::MODELMESHVERTEX> verts(mesh.vertices.size());
   for (std::size_t i = 0; i < verts.size(); ++i)
-    for (int k = 0; k < 3; ++k)
-      verts[i].m_fPosition[k] = static_cast<float>(mesh.vertices[i][k]);
+    for (int k = 0; k < 3; ++k) verts[i].m_fPosition[k] = static_cast<float>(mesh.vertices[i][k]);
   std::vector<NMR::MODELMESHTRIANGLE> tris(mesh.faces.size());
   for (std::size_t i = 0; i < tris.size(); ++i)
     for (int k = 0; k < 3; ++k) tris[i].m_nIndices[k] = static_cast<DWORD>(mesh.faces[i][k]);

@@ -4,6 +4,7 @@
 #include <cstring>
 #include <vector>
 
+#include "core/huge_pages.hpp"
 #include "io/repair.hpp"
 
 namespace nonplanar::io {
@@ -38,7 +39,7 @@ class IndexTable {
   explicit IndexTable(std::size_t n) {
     std::size_t cap = 16;
     while (cap < 2 * n) cap <<= 1;
-    slots_.assign(cap, -1);
+    assign_huge(slots_, cap, -1);
     mask_ = cap - 1;
   }
   // Visits slots starting at hash until visit() returns true (found) or an empty slot is
@@ -58,99 +59,103 @@ class IndexTable {
 
 }  // namespace
 
-TriangleMesh weld(const TriangleMesh& raw, double tolerance, std::size_t* collapsed) {
-  const std::size_t n = raw.vertices.size();
-  // Pass 1: exact duplicates (an STL repeats each shared vertex bit for bit).
-  std::vector<int> exact(n);
-  std::vector<int> unique;  // raw index of each unique point
-  unique.reserve(n / 4 + 16);
+TriangleMesh weld(TriangleMesh mesh, double tolerance, std::size_t* collapsed) {
+  std::vector<Vec3>& pts = mesh.vertices;
+  const std::size_t n = pts.size();
+  // Pass 1: exact duplicates (an STL repeats each shared vertex bit for bit; the binary
+  // reader has merged those already). Unique points are compacted to the front in place.
+  std::vector<int> map;
+  assign_huge(map, n, 0);
+  std::size_t nu = 0;
   {
     IndexTable table(n);
     for (std::size_t i = 0; i < n; ++i) {
-      const Vec3& p = raw.vertices[i];
-      const std::size_t s = table.probe(hash_point(p), [&](int u) {
-        return raw.vertices[unique[u]] == p;
-      });
+      const Vec3 p = pts[i];
+      const std::size_t s = table.probe(hash_point(p), [&](int u) { return pts[u] == p; });
       if (table.slot(s) < 0) {
-        table.slot(s) = static_cast<int>(unique.size());
-        unique.push_back(static_cast<int>(i));
+        table.slot(s) = static_cast<int>(nu);
+        pts[nu++] = p;
       }
-      exact[i] = table.slot(s);
+      map[i] = table.slot(s);
     }
   }
-  // Pass 2: tolerant merge of unique points on a grid of cell 2·tol. A point within tol of
-  // another lies in the same cell or the one next to it on the side nearer the point, so
-  // 8 cells are searched.
-  std::vector<int> to_out(unique.size());
-  TriangleMesh out;
-  out.vertices.reserve(unique.size());
+  // Pass 2: tolerant merge of unique points on a grid of cell 64·tol. A point within tol of
+  // another lies in the same cell, or in the neighbour across a face it is within tol of;
+  // so most points search one cell, and at most 8. Output points are compacted in place too
+  // (output index <= unique index, so nothing is overwritten before it is read).
+  std::vector<int> to_out;
+  assign_huge(to_out, nu, 0);
+  std::size_t no = 0;
   if (tolerance > 0) {
-    const double cell = 2.0 * tolerance, tol2 = tolerance * tolerance;
-    IndexTable table(unique.size());
-    std::vector<int> next;  // chain of output vertices in the same cell
-    std::vector<std::int64_t> cell_of;  // 3 per output vertex
-    for (std::size_t u = 0; u < unique.size(); ++u) {
-      const Vec3& p = raw.vertices[unique[u]];
+    const double cell = 64.0 * tolerance, tol2 = tolerance * tolerance;
+    const double near = tolerance / cell;  // a fraction of the cell
+    auto cell_of = [&](const Vec3& p, int k) {
+      return static_cast<std::int64_t>(std::floor(p[k] / cell));
+    };
+    IndexTable table(nu);
+    std::vector<int> next;  // chain of output points in the same cell
+    reserve_huge(next, nu);
+    for (std::size_t u = 0; u < nu; ++u) {
+      const Vec3 p = pts[u];
       std::int64_t c[3], side[3];
       for (int k = 0; k < 3; ++k) {
         const double f = p[k] / cell;
         c[k] = static_cast<std::int64_t>(std::floor(f));
-        side[k] = (f - static_cast<double>(c[k])) < 0.5 ? -1 : 1;
+        const double frac = f - static_cast<double>(c[k]);
+        side[k] = frac <= near ? -1 : frac >= 1.0 - near ? 1 : 0;
       }
+      auto probe_cell = [&](std::int64_t x, std::int64_t y, std::int64_t z) {
+        return table.probe(hash_cell(x, y, z), [&](int o) {
+          return cell_of(pts[o], 0) == x && cell_of(pts[o], 1) == y && cell_of(pts[o], 2) == z;
+        });
+      };
       int found = -1;
       for (int m = 0; m < 8 && found < 0; ++m) {
-        const std::int64_t q[3] = {c[0] + ((m & 1) ? side[0] : 0), c[1] + ((m & 2) ? side[1] : 0),
-                                   c[2] + ((m & 4) ? side[2] : 0)};
-        const std::size_t s = table.probe(hash_cell(q[0], q[1], q[2]), [&](int o) {
-          return cell_of[3 * o] == q[0] && cell_of[3 * o + 1] == q[1] && cell_of[3 * o + 2] == q[2];
-        });
+        if (((m & 1) && !side[0]) || ((m & 2) && !side[1]) || ((m & 4) && !side[2])) continue;
+        const std::size_t s =
+            probe_cell(c[0] + ((m & 1) ? side[0] : 0), c[1] + ((m & 2) ? side[1] : 0),
+                       c[2] + ((m & 4) ? side[2] : 0));
         for (int o = table.slot(s); o >= 0 && found < 0; o = next[o])
-          if ((out.vertices[o] - p).squaredNorm() <= tol2) found = o;
+          if ((pts[o] - p).squaredNorm() <= tol2) found = o;
       }
       if (found < 0) {
-        found = static_cast<int>(out.vertices.size());
-        out.vertices.push_back(p);
-        cell_of.insert(cell_of.end(), {c[0], c[1], c[2]});
-        const std::size_t s = table.probe(hash_cell(c[0], c[1], c[2]), [&](int o) {
-          return cell_of[3 * o] == c[0] && cell_of[3 * o + 1] == c[1] && cell_of[3 * o + 2] == c[2];
-        });
+        found = static_cast<int>(no);
+        pts[no++] = p;
+        const std::size_t s = probe_cell(c[0], c[1], c[2]);
         next.push_back(table.slot(s));  // prepend to the cell's chain
         table.slot(s) = found;
       }
       to_out[u] = found;
     }
   } else {
-    for (std::size_t u = 0; u < unique.size(); ++u) {
-      to_out[u] = static_cast<int>(u);
-      out.vertices.push_back(raw.vertices[unique[u]]);
-    }
+    for (std::size_t u = 0; u < nu; ++u) to_out[u] = static_cast<int>(u);
+    no = nu;
   }
 
-  std::size_t dropped = 0;
-  out.faces.reserve(raw.faces.size());
-  std::vector<char> used(out.vertices.size(), 0);
-  for (const auto& f : raw.faces) {
-    const std::array<int, 3> g = {to_out[exact[f[0]]], to_out[exact[f[1]]], to_out[exact[f[2]]]};
-    if (g[0] == g[1] || g[1] == g[2] || g[0] == g[2]) {
-      ++dropped;
-      continue;
-    }
+  // Remap faces in place, dropping those that lost a corner to the merge.
+  std::size_t kept = 0;
+  std::vector<char> used(no, 0);
+  for (const auto& f : mesh.faces) {
+    const std::array<int, 3> g = {to_out[map[f[0]]], to_out[map[f[1]]], to_out[map[f[2]]]};
+    if (g[0] == g[1] || g[1] == g[2] || g[0] == g[2]) continue;
     used[g[0]] = used[g[1]] = used[g[2]] = 1;
-    out.faces.push_back(g);
+    mesh.faces[kept++] = g;
   }
-  if (collapsed) *collapsed = dropped;
-  // Drop vertices no face uses (OBJ/OFF may list extras; collapsed faces leave some).
-  std::vector<int> remap(out.vertices.size(), -1);
+  if (collapsed) *collapsed = mesh.faces.size() - kept;
+  mesh.faces.resize(kept);
+  // Drop points no face uses (OBJ/OFF may list extras; collapsed faces leave some).
+  std::vector<int> remap(no, -1);
   std::size_t m = 0;
-  for (std::size_t i = 0; i < out.vertices.size(); ++i)
+  for (std::size_t i = 0; i < no; ++i)
     if (used[i]) {
       remap[i] = static_cast<int>(m);
-      out.vertices[m++] = out.vertices[i];
+      pts[m++] = pts[i];
     }
-  out.vertices.resize(m);
-  for (auto& f : out.faces)
+  pts.resize(m);
+  pts.shrink_to_fit();
+  for (auto& f : mesh.faces)
     for (int& v : f) v = remap[v];
-  return out;
+  return mesh;
 }
 
 std::size_t count_zero_area_faces(const TriangleMesh& mesh, double tolerance) {

@@ -59,8 +59,8 @@ TEST(Curvature, ConeApexIsDiscontinuous) {
   std::vector<char> mask(m.faces.size(), 0);
   for (std::size_t f = 0; f < m.faces.size(); ++f) mask[f] = geom.normals[f].z() > 0.5;
   const auto c = angle_deficit(m, topo, geom, &mask);
-  const auto disc = analysis::discontinuous_vertices(m, c, mask, AnalysisParams{}.tau,
-                                                     AnalysisParams{}.epsilon);
+  const auto disc =
+      analysis::discontinuous_vertices(m, c, mask, AnalysisParams{}.tau, AnalysisParams{}.epsilon);
   const int apex = 10 * 21 + 10;  // grid vertex at (0, 0)
   EXPECT_NEAR(m.vertices[apex].z(), 10.0, 1e-12);
   EXPECT_TRUE(disc[apex]);

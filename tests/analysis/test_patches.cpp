@@ -88,10 +88,10 @@ TEST(Patches, PlateauWithTwoGaussianBumpsIsOnePatch) {
 }
 
 TEST(Patches, TinyAndFlatPatchesAreClassified) {
-  TriangleMesh m = test::box({0, 0, 0}, {1, 1, 1});                     // 1 mm² flat top
-  test::append(m, test::height_field_solid([](double x, double) { return 2 + 0.3 * x; }, 5, 6,
-                                           0, 1, 2, 2));                // 1 mm² sloped
-  test::append(m, test::box({10, 0, 0}, {30, 20, 4}));                  // 400 mm² flat
+  TriangleMesh m = test::box({0, 0, 0}, {1, 1, 1});  // 1 mm² flat top
+  test::append(m, test::height_field_solid([](double x, double) { return 2 + 0.3 * x; }, 5, 6, 0, 1,
+                                           2, 2));      // 1 mm² sloped
+  test::append(m, test::box({10, 0, 0}, {30, 20, 4}));  // 400 mm² flat
   AnalysisParams p;
   auto a = analyze(m, p, {});
   ASSERT_TRUE(a);

@@ -29,10 +29,10 @@ CliResult run(const std::string& args) {
 TEST(Cli, AnalyzeJsonReportsPatches) {
   const auto dir = test::temp_dir("cli_json");
   const double t = std::tan(15.0 * M_PI / 180.0);
-  ASSERT_TRUE(write_stl(dir / "roof.stl",
-                        test::height_field_solid(
-                            [&](double x, double) { return 5 + t * (10 - std::abs(x - 10)); }, 0,
-                            20, 0, 30, 8, 6)));
+  ASSERT_TRUE(write_stl(
+      dir / "roof.stl",
+      test::height_field_solid([&](double x, double) { return 5 + t * (10 - std::abs(x - 10)); }, 0,
+                               20, 0, 30, 8, 6)));
   const CliResult r = run("analyze --json " + (dir / "roof.stl").string());
   ASSERT_EQ(r.code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
@@ -48,7 +48,7 @@ TEST(Cli, ExportPatchesWritesAColouredPly) {
   const auto dir = test::temp_dir("cli_ply");
   ASSERT_TRUE(write_stl(dir / "s.stl", test::icosphere({0, 0, 0}, 15, 3)));
   const CliResult r = run("analyze -q " + (dir / "s.stl").string() + " --export-patches " +
-                    (dir / "p.ply").string());
+                          (dir / "p.ply").string());
   ASSERT_EQ(r.code, 0) << r.err;
   const std::string ply = test::read_bytes(dir / "p.ply");
   EXPECT_EQ(ply.rfind("ply\nformat ascii 1.0\n", 0), 0u);

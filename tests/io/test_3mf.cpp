@@ -66,11 +66,13 @@ TEST(ThreeMfErrors, ZipThatIsNot3mfAndRandomBytes) {
   const auto dir = test::temp_dir("3mf_bad");
   // A valid zip (stored, one empty file "a.txt"), but no 3MF model inside.
   const unsigned char zip[] = {
-      0x50, 0x4b, 0x03, 0x04, 0x0a, 0, 0, 0, 0, 0, 0, 0, 0x21, 0, 0, 0, 0, 0, 0, 0, 0, 0,
-      0, 0, 0, 0, 0x05, 0, 0, 0, 'a', '.', 't', 'x', 't', 0x50, 0x4b, 0x01, 0x02, 0x14, 0,
-      0x0a, 0, 0, 0, 0, 0, 0, 0, 0x21, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0x05, 0, 0,
-      0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 'a', '.', 't', 'x', 't', 0x50, 0x4b,
-      0x05, 0x06, 0, 0, 0, 0, 0x01, 0, 0x01, 0, 0x33, 0, 0, 0, 0x23, 0, 0, 0, 0, 0};
+      0x50, 0x4b, 0x03, 0x04, 0x0a, 0,    0,    0,    0,    0,    0,    0, 0x21, 0, 0,   0,
+      0,    0,    0,    0,    0,    0,    0,    0,    0,    0,    0x05, 0, 0,    0, 'a', '.',
+      't',  'x',  't',  0x50, 0x4b, 0x01, 0x02, 0x14, 0,    0x0a, 0,    0, 0,    0, 0,   0,
+      0,    0x21, 0,    0,    0,    0,    0,    0,    0,    0,    0,    0, 0,    0, 0,   0x05,
+      0,    0,    0,    0,    0,    0,    0,    0,    0,    0,    0,    0, 0,    0, 0,   0,
+      0,    0,    'a',  '.',  't',  'x',  't',  0x50, 0x4b, 0x05, 0x06, 0, 0,    0, 0,   0x01,
+      0,    0x01, 0,    0x33, 0,    0,    0,    0x23, 0,    0,    0,    0, 0};
   test::write_bytes(dir / "zip.3mf", std::string(reinterpret_cast<const char*>(zip), sizeof zip));
   auto r = load_mesh(dir / "zip.3mf", {}, {});
   ASSERT_FALSE(r);

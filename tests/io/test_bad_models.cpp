@@ -19,18 +19,23 @@ struct Expect {
 
 const Expect kExpect[] = {
     // file                                     faces open nm  inc   zero coll shells flip inv
-    {"bad_aaron_mouse_nonmanifold.stl",           256, 0, 0, 0, 0, 4, 1, 0, false},
-    {"bad_assimp_Spider_binary.stl",             1312, 72, 0, 10, 0, 56, 18, 4, false},
-    {"bad_assimp_sphereWithHole.stl",             285, 9, 0, 0, 0, 0, 1, 0, false},
-    {"bad_cgal_blobby-shuffled.off",             4050, 0, 0, 3069, 0, 0, 1, 2017, false},
-    {"bad_cgal_elephant-with-holes.off",         4463, 1353, 0, 0, 0, 0, 1, 0, false},
-    {"bad_cgal_ellipsoid_inverted.off",          3108, 0, 0, 0, 0, 0, 1, 3108, true},
+    {"bad_aaron_mouse_nonmanifold.stl", 256, 0, 0, 0, 0, 4, 1, 0, false},
+    {"bad_assimp_Spider_binary.stl", 1312, 72, 0, 10, 0, 56, 18, 4, false},
+    {"bad_assimp_sphereWithHole.stl", 285, 9, 0, 0, 0, 0, 1, 0, false},
+    {"bad_cgal_blobby-shuffled.off", 4050, 0, 0, 3069, 0, 0, 1, 2017, false},
+    {"bad_cgal_elephant-with-holes.off", 4463, 1353, 0, 0, 0, 0, 1, 0, false},
+    {"bad_cgal_ellipsoid_inverted.off", 3108, 0, 0, 0, 0, 0, 1, 3108, true},
     {"bad_manifold_openscad-nonmanifold-crash.obj", 1436, 0, 19, 0, 34, 6, 1, 0, false},
-    {"bad_manifold_self_intersectA.obj",        17160, 0, 0, 0, 0, 0, 1, 0, false},
-    {"bad_openscad_back-to-back.stl",              10, 0, 2, 0, 2, 0, 1, 0, false},
-    {"bad_openscad_bad-stl-wing.stl",             842, 0, 0, 0, 24, 0, 1, 0, false},
-    {"bad_openscad_zero-area-triangle.stl",        14, 0, 0, 0, 1, 0, 1, 0, false},
+    {"bad_manifold_self_intersectA.obj", 17160, 0, 0, 0, 0, 0, 1, 0, false},
+    {"bad_openscad_back-to-back.stl", 10, 0, 2, 0, 2, 0, 1, 0, false},
+    {"bad_openscad_bad-stl-wing.stl", 842, 0, 0, 0, 24, 0, 1, 0, false},
+    {"bad_openscad_zero-area-triangle.stl", 14, 0, 0, 0, 1, 0, 1, 0, false},
 };
+
+// Readable test names in ctest output instead of the struct's bytes.
+void PrintTo(const Expect& e, std::ostream* os) {
+  *os << e.file;
+}
 
 class BadModel : public ::testing::TestWithParam<Expect> {};
 

@@ -77,8 +77,9 @@ TEST(Off, ParsesCommentsAndFaceColours) {
 }
 
 TEST(Off, CountsOnHeaderLineAndPolygons) {
-  auto r = io::parse_off("OFF 8 6 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n0 0 1\n1 0 1\n1 1 1\n0 1 1\n"
-                         "4 0 3 2 1\n4 4 5 6 7\n4 0 1 5 4\n4 1 2 6 5\n4 2 3 7 6\n4 3 0 4 7\n");
+  auto r = io::parse_off(
+      "OFF 8 6 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n0 0 1\n1 0 1\n1 1 1\n0 1 1\n"
+      "4 0 3 2 1\n4 4 5 6 7\n4 0 1 5 4\n4 1 2 6 5\n4 2 3 7 6\n4 3 0 4 7\n");
   ASSERT_TRUE(r) << r.error().message;
   EXPECT_EQ(r->faces.size(), 12u);
   EXPECT_NEAR(signed_volume(*r), 1.0, 1e-12);

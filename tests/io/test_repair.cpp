@@ -39,7 +39,7 @@ TEST(Weld, DropsCollapsedFacesAndUnusedVertices) {
   TriangleMesh m = test::box({0, 0, 0}, {1, 1, 1});
   m.vertices.emplace_back(0.5, 0.5, 1.0);
   m.vertices.emplace_back(0.5, 0.5, 1.0 + 1e-9);  // same point within tolerance
-  m.vertices.emplace_back(7, 7, 7);                // never used
+  m.vertices.emplace_back(7, 7, 7);               // never used
   const int a = static_cast<int>(m.vertices.size()) - 3;
   m.faces.push_back({a, a + 1, 0});  // collapses to an edge
   std::size_t collapsed = 0;

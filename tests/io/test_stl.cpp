@@ -105,7 +105,9 @@ void expect_error(const std::string& bytes, Status status, const std::string& ne
   EXPECT_EQ(r.error().message.find('\n'), std::string::npos);
 }
 
-TEST(StlErrors, EmptyFile) { expect_error("", Status::parse_error, "empty"); }
+TEST(StlErrors, EmptyFile) {
+  expect_error("", Status::parse_error, "empty");
+}
 
 TEST(StlErrors, TruncatedBinary) {
   std::string b = binary_stl_bytes(sample_solid());
@@ -142,7 +144,9 @@ TEST(StlErrors, AsciiEndingInsideFacet) {
                Status::parse_error, "ends inside a facet");
 }
 
-TEST(StlErrors, ShortGarbage) { expect_error("hello", Status::parse_error, "too short"); }
+TEST(StlErrors, ShortGarbage) {
+  expect_error("hello", Status::parse_error, "too short");
+}
 
 TEST(StlErrors, LoaderPrefixesFileNameAndRejectsMissingFiles) {
   const auto dir = test::temp_dir("stl_missing");

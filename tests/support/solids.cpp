@@ -32,19 +32,19 @@ TriangleMesh height_field_solid(const std::function<double(double, double)>& f, 
     m.faces.push_back({a_bot, b_top, a_top});
   };
   for (int i = 0; i < nx; ++i) {
-    wall(top(i, 0), top(i + 1, 0), bot(i, 0), bot(i + 1, 0));              // y = y0 side
-    wall(top(i + 1, ny), top(i, ny), bot(i + 1, ny), bot(i, ny));          // y = y1 side
+    wall(top(i, 0), top(i + 1, 0), bot(i, 0), bot(i + 1, 0));      // y = y0 side
+    wall(top(i + 1, ny), top(i, ny), bot(i + 1, ny), bot(i, ny));  // y = y1 side
   }
   for (int j = 0; j < ny; ++j) {
-    wall(top(nx, j), top(nx, j + 1), bot(nx, j), bot(nx, j + 1));          // x = x1 side
-    wall(top(0, j + 1), top(0, j), bot(0, j + 1), bot(0, j));              // x = x0 side
+    wall(top(nx, j), top(nx, j + 1), bot(nx, j), bot(nx, j + 1));  // x = x1 side
+    wall(top(0, j + 1), top(0, j), bot(0, j + 1), bot(0, j));      // x = x0 side
   }
   return m;
 }
 
 TriangleMesh box(const Vec3& lo, const Vec3& hi) {
-  return height_field_solid([&](double, double) { return hi.z(); }, lo.x(), hi.x(), lo.y(),
-                            hi.y(), 1, 1, lo.z());
+  return height_field_solid([&](double, double) { return hi.z(); }, lo.x(), hi.x(), lo.y(), hi.y(),
+                            1, 1, lo.z());
 }
 
 TriangleMesh subdivide(const TriangleMesh& in, int levels) {
@@ -77,11 +77,11 @@ TriangleMesh subdivide(const TriangleMesh& in, int levels) {
 TriangleMesh icosphere(const Vec3& c, double r, int levels) {
   const double t = (1.0 + std::sqrt(5.0)) / 2.0;
   TriangleMesh m;
-  m.vertices = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
-                {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
-  m.faces = {{0, 11, 5}, {0, 5, 1}, {0, 1, 7},  {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
-             {11, 10, 2}, {10, 7, 6}, {7, 1, 8}, {3, 9, 4}, {3, 4, 2},  {3, 2, 6}, {3, 6, 8},
-             {3, 8, 9},  {4, 9, 5},  {2, 4, 11}, {6, 2, 10}, {8, 6, 7}, {9, 8, 1}};
+  m.vertices = {{-1, t, 0},  {1, t, 0},  {-1, -t, 0}, {1, -t, 0}, {0, -1, t},  {0, 1, t},
+                {0, -1, -t}, {0, 1, -t}, {t, 0, -1},  {t, 0, 1},  {-t, 0, -1}, {-t, 0, 1}};
+  m.faces = {{0, 11, 5},  {0, 5, 1},  {0, 1, 7},  {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
+             {11, 10, 2}, {10, 7, 6}, {7, 1, 8},  {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
+             {3, 8, 9},   {4, 9, 5},  {2, 4, 11}, {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
   m = subdivide(m, levels);
   for (Vec3& v : m.vertices) v = c + r * v.normalized();
   return m;

@@ -13,8 +13,7 @@ namespace nonplanar::test {
 /// Closed block over [x0,x1]×[y0,y1]: top z = f(x, y) on an nx × ny grid of quads, flat
 /// bottom at z = base, vertical walls. Requires f > base.
 TriangleMesh height_field_solid(const std::function<double(double, double)>& f, double x0,
-                                double x1, double y0, double y1, int nx, int ny,
-                                double base = 0.0);
+                                double x1, double y0, double y1, int nx, int ny, double base = 0.0);
 
 /// Axis-aligned box.
 TriangleMesh box(const Vec3& min, const Vec3& max);

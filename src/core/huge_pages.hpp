@@ -1,0 +1,41 @@
+// Large arrays fault in 4 KiB pages on first touch, and page faults are expensive on
+// virtual machines (a third of load time on a 1M-triangle mesh here). Asking for
+// transparent huge pages on a fresh buffer before touching it cuts the faults 512-fold.
+#pragma once
+
+#include <sys/mman.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+namespace nonplanar {
+
+/// Advise the kernel to back [p, p + bytes) with huge pages (only whole 2 MiB pages inside
+/// the range; small ranges are left alone). Harmless where THP is off.
+inline void advise_huge_pages(const void* p, std::size_t bytes) {
+  constexpr std::uintptr_t kHuge = 2u << 20;
+  if (bytes < 2 * kHuge) return;
+  const auto a = reinterpret_cast<std::uintptr_t>(p);
+  const std::uintptr_t lo = (a + kHuge - 1) & ~(kHuge - 1);
+  const std::uintptr_t hi = (a + bytes) & ~(kHuge - 1);
+  if (hi > lo) ::madvise(reinterpret_cast<void*>(lo), hi - lo, MADV_HUGEPAGE);
+}
+
+/// v.reserve(n), then the advice above on the new buffer (before anything touches it).
+template <class T, class A>
+void reserve_huge(std::vector<T, A>& v, std::size_t n) {
+  if (v.capacity() >= n) return;
+  v.reserve(n);
+  advise_huge_pages(v.data(), n * sizeof(T));
+}
+
+/// v = n copies of x, in a huge-page-advised buffer.
+template <class T, class A>
+void assign_huge(std::vector<T, A>& v, std::size_t n, const T& x) {
+  std::vector<T, A>().swap(v);
+  reserve_huge(v, n);
+  v.assign(n, x);
+}
+
+}  // namespace nonplanar
