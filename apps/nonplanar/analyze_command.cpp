@@ -169,23 +169,7 @@ void register_analyze(CLI::App& app, std::function<int()>* run_fn) {
       "Find the faces a nozzle can follow (slope below --max-angle) and split them into\n"
       "patches at curvature discontinuities and creases; print the patches.");
   opts->mesh.add_to(*cmd);
-  AnalysisParams& p = opts->params;
-  cmd->add_option("--max-angle", p.max_angle_deg,
-                  "Steepest printable face, degrees from horizontal (nozzle geometry)")
-      ->capture_default_str();
-  cmd->add_option("--tau", p.tau, "Curvature threshold K/A for a discontinuous vertex (1/mm^2)")
-      ->capture_default_str();
-  cmd->add_option("--epsilon", p.epsilon,
-                  "Largest curvature jump between neighbouring vertices (1/mm^2)")
-      ->capture_default_str();
-  cmd->add_option("--crease-angle", p.crease_angle_deg,
-                  "Dihedral angle between faces that splits a patch (degrees)")
-      ->capture_default_str();
-  cmd->add_option("--min-layer-height", p.min_layer_height,
-                  "A patch whose height range is below this is flat (mm)")
-      ->capture_default_str();
-  cmd->add_option("--min-patch-area", p.min_patch_area, "Smaller patches are dropped (mm^2)")
-      ->capture_default_str();
+  add_analysis_options(*cmd, opts->params);
   cmd->add_flag("--json", opts->json, "Print one JSON document instead of the summary");
   cmd->add_option("--export-patches", opts->export_patches,
                   "Write the mesh as PLY with one colour per patch (grey: not printable "

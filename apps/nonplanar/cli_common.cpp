@@ -20,6 +20,25 @@ void MeshOptions::add_to(CLI::App& cmd) {
   cmd.add_flag("-q,--quiet", quiet, "No progress or warnings on stderr");
 }
 
+void add_analysis_options(CLI::App& cmd, AnalysisParams& p) {
+  cmd.add_option("--max-angle", p.max_angle_deg,
+                 "Steepest printable face, degrees from horizontal (nozzle geometry)")
+      ->capture_default_str();
+  cmd.add_option("--tau", p.tau, "Curvature threshold K/A for a discontinuous vertex (1/mm^2)")
+      ->capture_default_str();
+  cmd.add_option("--epsilon", p.epsilon,
+                 "Largest curvature jump between neighbouring vertices (1/mm^2)")
+      ->capture_default_str();
+  cmd.add_option("--crease-angle", p.crease_angle_deg,
+                 "Dihedral angle between faces that splits a patch (degrees)")
+      ->capture_default_str();
+  cmd.add_option("--min-layer-height", p.min_layer_height,
+                 "A patch whose height range is below this is flat (mm)")
+      ->capture_default_str();
+  cmd.add_option("--min-patch-area", p.min_patch_area, "Smaller patches are dropped (mm^2)")
+      ->capture_default_str();
+}
+
 int report_error(const Error& e) {
   std::fprintf(stderr, "error: %s\n", e.message.c_str());
   switch (e.status) {

@@ -5,6 +5,7 @@
 #include <CLI/CLI.hpp>
 #include <string>
 
+#include "nonplanar/analysis.hpp"
 #include "nonplanar/context.hpp"
 #include "nonplanar/io.hpp"
 #include "nonplanar/status.hpp"
@@ -23,6 +24,9 @@ struct MeshOptions {
   bool quiet = false;
   void add_to(CLI::App& cmd);
 };
+
+/// The analysis stage's options (--max-angle, --tau, ...), added to a subcommand.
+void add_analysis_options(CLI::App& cmd, AnalysisParams& p);
 
 /// Prints "error: MESSAGE" on stderr; returns the exit code for the status.
 int report_error(const Error& e);

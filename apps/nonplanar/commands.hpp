@@ -8,5 +8,7 @@ namespace nonplanar::cli {
 
 /// Adds "analyze" to app; *run is set to the function main calls when it is chosen.
 void register_analyze(CLI::App& app, std::function<int()>* run);
+/// Adds "fit".
+void register_fit(CLI::App& app, std::function<int()>* run);
 
 }  // namespace nonplanar::cli

@@ -17,6 +17,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   std::function<int()> run;
   register_analyze(app, &run);
+  register_fit(app, &run);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -70,6 +70,37 @@ TEST(Cli, BadInputIsOneLineAndExitTwo) {
   EXPECT_EQ(bad_angle.code, 2);
 }
 
+TEST(Cli, FitReportsErrorsAndExportsSurfaces) {
+  const auto dir = test::temp_dir("cli_fit");
+  ASSERT_TRUE(write_stl(
+      dir / "w.stl", test::height_field_solid(
+                         [](double x, double y) { return 6 + std::sin(x / 4) * std::cos(y / 5); },
+                         0, 30, 0, 20, 90, 60)));
+  const CliResult r = run("fit --json " + (dir / "w.stl").string() + " --export-surfaces " +
+                          (dir / "s.json").string() + " --export-mesh " + (dir / "s.obj").string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  ASSERT_EQ(j["surfaces"].size(), 1u);
+  const auto& s = j["surfaces"][0];
+  EXPECT_LE(s["rms_error"].get<double>(), 0.005);
+  EXPECT_LE(s["max_error"].get<double>(), 0.02);
+  EXPECT_GE(s["control_grid"][0].get<int>(), 4);
+  // The polynomial fit met the tolerance, so the default stops there ...
+  EXPECT_EQ(s["nonlinear"]["solver"], "none");
+  // ... and --always-refine runs the rational and Levenberg–Marquardt steps, lowering the error.
+  const CliResult full = run("fit --json --always-refine " + (dir / "w.stl").string());
+  ASSERT_EQ(full.code, 0) << full.err;
+  const auto fs = nlohmann::json::parse(full.out)["surfaces"][0];
+  EXPECT_EQ(fs["nonlinear"]["solver"], "levenberg-marquardt");
+  EXPECT_GT(fs["nonlinear"]["iterations"].get<int>(), 0);
+  EXPECT_LE(fs["rms_error"].get<double>(), s["rms_error"].get<double>());
+  const auto doc = nlohmann::json::parse(test::read_bytes(dir / "s.json"));
+  EXPECT_EQ(doc["format"], "nonplanar-surfaces");
+  EXPECT_EQ(doc["surfaces"][0]["control_points"].size(), doc["surfaces"][0]["weights"].size());
+  EXPECT_FALSE(test::read_bytes(dir / "s.obj").empty());
+  EXPECT_EQ(run("fit --solver bogus " + (dir / "w.stl").string()).code, 2);
+}
+
 TEST(Cli, HelpAndUsage) {
   const CliResult h = run("analyze --help");
   EXPECT_EQ(h.code, 0);

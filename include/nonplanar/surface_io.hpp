@@ -1,0 +1,38 @@
+// Exchange format of fitted surfaces (docs/surface-format.md): JSON with degrees, knots,
+// control points, weights and the (x, y) → (u, v) map, so any tool can evaluate them; and
+// an OBJ tessellation for viewers.
+#pragma once
+
+#include <filesystem>
+#include <vector>
+
+#include "nonplanar/nurbs.hpp"
+#include "nonplanar/status.hpp"
+
+namespace nonplanar {
+
+/// One surface in a file: the patch it belongs to, the height field and its fit errors (mm).
+struct SurfaceRecord {
+  int patch = -1;
+  HeightField surface;
+  double rms_error = 0, max_error = 0;
+};
+
+/// Writes {"format": "nonplanar-surfaces", "version": 1, "units": "mm", "surfaces": [...]}.
+/// Atomic.
+Expected<bool> write_surfaces_json(const std::filesystem::path& file,
+                                   const std::vector<SurfaceRecord>& surfaces);
+
+/// Reads what write_surfaces_json wrote; every surface is checked with valid().
+/// Errors: "FILE: what is wrong" (parse_error).
+Expected<std::vector<SurfaceRecord>> read_surfaces_json(const std::filesystem::path& file);
+
+/// Parses the JSON text itself (for tests and fuzzing); errors without the file name.
+Expected<std::vector<SurfaceRecord>> parse_surfaces_json(std::string_view text);
+
+/// Each surface tessellated over its footprint rectangle as a `resolution`² grid of quads
+/// (two triangles each), one OBJ group per surface. Atomic.
+Expected<bool> write_surfaces_obj(const std::filesystem::path& file,
+                                  const std::vector<SurfaceRecord>& surfaces, int resolution = 64);
+
+}  // namespace nonplanar

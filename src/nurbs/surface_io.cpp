@@ -1,0 +1,134 @@
+#include "nonplanar/surface_io.hpp"
+
+#include <nlohmann/json.hpp>
+#include <ostream>
+
+#include "core/atomic_file.hpp"
+#include "io/mesh_buffer.hpp"
+
+namespace nonplanar {
+
+using nlohmann::ordered_json;
+
+namespace {
+
+ordered_json to_json(const SurfaceRecord& r) {
+  const NurbsSurface& s = r.surface.surface;
+  ordered_json pts = ordered_json::array();
+  for (const Vec3& p : s.points) pts.push_back({p.x(), p.y(), p.z()});
+  return {{"patch", r.patch},
+          {"degree_u", s.p},
+          {"degree_v", s.q},
+          {"count_u", s.n_u},
+          {"count_v", s.n_v},
+          {"knots_u", s.U},
+          {"knots_v", s.V},
+          {"control_points", std::move(pts)},
+          {"weights", s.weights},
+          {"uv_map",
+           {{"origin", {r.surface.origin.x(), r.surface.origin.y()}},
+            {"extent", {r.surface.extent.x(), r.surface.extent.y()}}}},
+          {"rms_error", r.rms_error},
+          {"max_error", r.max_error}};
+}
+
+SurfaceRecord from_json(const nlohmann::json& j) {
+  SurfaceRecord r;
+  NurbsSurface& s = r.surface.surface;
+  r.patch = j.at("patch").get<int>();
+  s.p = j.at("degree_u").get<int>();
+  s.q = j.at("degree_v").get<int>();
+  s.n_u = j.at("count_u").get<int>();
+  s.n_v = j.at("count_v").get<int>();
+  s.U = j.at("knots_u").get<std::vector<double>>();
+  s.V = j.at("knots_v").get<std::vector<double>>();
+  for (const auto& p : j.at("control_points")) {
+    if (!p.is_array() || p.size() != 3) throw std::runtime_error("control point needs 3 numbers");
+    s.points.emplace_back(p[0].get<double>(), p[1].get<double>(), p[2].get<double>());
+  }
+  s.weights = j.at("weights").get<std::vector<double>>();
+  const auto& m = j.at("uv_map");
+  r.surface.origin = {m.at("origin").at(0).get<double>(), m.at("origin").at(1).get<double>()};
+  r.surface.extent = {m.at("extent").at(0).get<double>(), m.at("extent").at(1).get<double>()};
+  r.rms_error = j.value("rms_error", 0.0);
+  r.max_error = j.value("max_error", 0.0);
+  return r;
+}
+
+}  // namespace
+
+Expected<bool> write_surfaces_json(const std::filesystem::path& file,
+                                   const std::vector<SurfaceRecord>& surfaces) {
+  ordered_json doc = {{"format", "nonplanar-surfaces"}, {"version", 1}, {"units", "mm"}};
+  ordered_json arr = ordered_json::array();
+  for (const auto& r : surfaces) arr.push_back(to_json(r));
+  doc["surfaces"] = std::move(arr);
+  const std::string text = doc.dump(1) + "\n";
+  return write_file_atomically(file, [&](std::ostream& out) {
+    out << text;
+    return bool(out);
+  });
+}
+
+Expected<std::vector<SurfaceRecord>> parse_surfaces_json(std::string_view text) {
+  const auto j = nlohmann::json::parse(text.begin(), text.end(), nullptr, false);
+  if (j.is_discarded()) return Error{Status::parse_error, "not valid JSON"};
+  if (!j.is_object() || j.value("format", "") != "nonplanar-surfaces")
+    return Error{Status::parse_error, "not a nonplanar-surfaces document"};
+  if (j.value("version", 0) != 1) return Error{Status::unsupported, "unknown version"};
+  std::vector<SurfaceRecord> out;
+  try {
+    for (const auto& s : j.at("surfaces")) {
+      out.push_back(from_json(s));
+      const auto& r = out.back();
+      if (!r.surface.surface.valid() || !(r.surface.extent.x() > 0) ||
+          !(r.surface.extent.y() > 0) || !r.surface.origin.allFinite() ||
+          !r.surface.extent.allFinite())
+        return Error{Status::parse_error,
+                     "surface " + std::to_string(out.size() - 1) +
+                         ": inconsistent degrees, knots, control points or weights"};
+    }
+  } catch (const std::exception& e) {
+    return Error{Status::parse_error, "surface " + std::to_string(out.size()) + ": " + e.what()};
+  }
+  return out;
+}
+
+Expected<std::vector<SurfaceRecord>> read_surfaces_json(const std::filesystem::path& file) {
+  auto bytes = io::read_file_bytes(file, 1u << 30);
+  if (!bytes) return Error{bytes.error().status, file.string() + ": " + bytes.error().message};
+  auto r = parse_surfaces_json(bytes->view());
+  if (!r) return Error{r.error().status, file.string() + ": " + r.error().message};
+  return r;
+}
+
+Expected<bool> write_surfaces_obj(const std::filesystem::path& file,
+                                  const std::vector<SurfaceRecord>& surfaces, int resolution) {
+  resolution = std::max(resolution, 1);
+  return write_file_atomically(file, [&](std::ostream& out) {
+    out << "# nonplanar fitted surfaces: one group per patch, z = S(u(x), v(y))\n";
+    out.precision(9);
+    long base = 1;
+    for (const auto& r : surfaces) {
+      out << "g patch_" << r.patch << "\n";
+      const HeightField& h = r.surface;
+      for (int i = 0; i <= resolution; ++i)
+        for (int j = 0; j <= resolution; ++j) {
+          const double x = h.origin.x() + h.extent.x() * i / resolution;
+          const double y = h.origin.y() + h.extent.y() * j / resolution;
+          out << "v " << x << ' ' << y << ' ' << h.height(x, y) << '\n';
+        }
+      const int n = resolution + 1;
+      for (int i = 0; i < resolution; ++i)
+        for (int j = 0; j < resolution; ++j) {
+          const long a = base + i * n + j, b = a + n;
+          out << "f " << a << ' ' << b << ' ' << b + 1 << "\nf " << a << ' ' << b + 1 << ' '
+              << a + 1 << '\n';
+        }
+      base += static_cast<long>(n) * n;
+    }
+    return bool(out);
+  });
+}
+
+}  // namespace nonplanar
