@@ -1,0 +1,100 @@
+// Stage layers (paper §5–7; DESIGN.md §2 step 4, §3): curved layer stacks under the fitted
+// patches, the printability cost and its optimiser, and the layer field over the whole part.
+//
+// Notation: h layer height, h₁ first-layer height, [h_min, h_max] allowed thickness. A patch's
+// stack has N + 1 surfaces S_0 = S_f (the fitted top) ... S_N = plane z = c; the thickness of
+// layer i is t_i = S_i − S_{i+1}. The layer field T(x, y, z) is a monotone layer coordinate
+// (integer on layer boundaries); ζ(T) is the planar height of boundary T (ζ = z where the
+// layers are planar), so the normalised mesh is (x, y, ζ(T(x, y, z))).
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "nonplanar/analysis.hpp"
+#include "nonplanar/fit.hpp"
+
+namespace nonplanar {
+
+enum class StackOptimizer { gradient_descent, lbfgs };
+
+/// Printer limits and optimiser settings. Millimetres and degrees.
+struct LayerParams {
+  double layer_height = 0.2;        ///< h
+  double first_layer_height = 0.2;  ///< h₁
+  double min_layer_height = 0.1;    ///< h_min
+  double max_layer_height = 0.3;    ///< h_max
+  double max_angle_deg = 30.0;      ///< steepest layer the nozzle cone allows
+  double nozzle_tip_radius = 0.4;   ///< flat of the nozzle tip
+  double nozzle_angle_deg = 45.0;   ///< nozzle wall above horizontal
+  double block_radius = 8.0;        ///< heater block, from the nozzle axis
+  double block_clearance = 4.0;     ///< heater block bottom above the nozzle tip
+  double continuity_weight = 0.05;  ///< λ of eq. (1)
+  StackOptimizer optimizer = StackOptimizer::lbfgs;
+  int max_iterations = 100;
+  double grid_step = 0.5;  ///< quadrature and check spacing over the footprint
+};
+
+/// The curved layers of one patch.
+struct LayerStack {
+  int patch = -1;
+  double c = 0;                       ///< the bottom plane, a planar layer boundary
+  int layers = 0;                     ///< N
+  double T_bottom = 0;                ///< layer coordinate of the plane c
+  std::vector<HeightField> surfaces;  ///< S_0 (top) … S_N (plane), same knots and weights
+  Vec2 xy_min{0, 0}, xy_max{0, 0};    ///< the patch's footprint
+  // Figures over the patch, mm and degrees (after optimisation).
+  double thickness_min = 0, thickness_max = 0;
+  double max_slope_deg = 0;
+  double max_block_rise = 0;  ///< largest rise of a layer within the block radius
+  double cost_before = 0, cost_after = 0;
+  int iterations = 0;
+  std::string optimizer_message;
+};
+
+/// A patch that keeps planar layers, and why.
+struct PlanarFallback {
+  int patch = -1;
+  std::string reason;
+};
+
+class LayerField;
+
+/// Output of plan_layers: the stacks, the fallbacks and the field built from the stacks.
+struct LayerPlan {
+  std::vector<LayerStack> stacks;
+  std::vector<PlanarFallback> fallbacks;
+  std::shared_ptr<const LayerField> field;
+};
+
+/// Build, optimise and check a stack per patch that needs non-planar layers (fits[i] is the
+/// surface of analysis.patches[patch_of_fit[i]]), then the layer field. A stack that cannot
+/// meet the limits falls back to planar with a reason; never an unprintable stack.
+/// Errors: invalid_argument naming the key, cancelled.
+Expected<LayerPlan> plan_layers(const TriangleMesh& mesh, const Analysis& analysis,
+                                const std::vector<SurfaceFit>& fits,
+                                const std::vector<int>& patch_of_fit, const LayerParams& params,
+                                const Context& ctx);
+
+/// The layer field T over the whole part: planar (ζ = z) outside the curved bands, each band
+/// blended C² into the planar layers around it; strictly increasing in z.
+class LayerField {
+ public:
+  virtual ~LayerField() = default;
+  /// T(x, y, z).
+  virtual double T(double x, double y, double z) const = 0;
+  /// z with T(x, y, z) = t (the inverse along the vertical; |error| < 1e-9 mm).
+  virtual double z_at(double x, double y, double t) const = 0;
+  /// Planar height of layer coordinate t: ζ(t).
+  virtual double zeta(double t) const = 0;
+  /// Inverse of zeta.
+  virtual double t_of_zeta(double zeta) const = 0;
+  /// Local layer thickness at (x, y, z): 1 / ∂T/∂z, mm.
+  virtual double thickness(double x, double y, double z) const = 0;
+};
+
+/// A planar-only field (first layer h₁, then h).
+std::shared_ptr<const LayerField> planar_field(const LayerParams& params);
+
+}  // namespace nonplanar

@@ -1,0 +1,92 @@
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <unordered_map>
+
+#include "nonplanar/deform.hpp"
+
+namespace nonplanar {
+namespace {
+
+Vec3 mapped(const LayerField& f, const Vec3& p) {
+  return {p.x(), p.y(), f.zeta(f.T(p.x(), p.y(), p.z()))};
+}
+
+std::uint64_t edge_key(int a, int b) {
+  const auto [lo, hi] = std::minmax(a, b);
+  return (static_cast<std::uint64_t>(lo) << 32) | static_cast<std::uint32_t>(hi);
+}
+
+}  // namespace
+
+Expected<NormalizedMesh> normalize_mesh(const TriangleMesh& mesh, const LayerField& field,
+                                        const NormalizeParams& params, const Context& ctx) {
+  if (!std::isfinite(params.tolerance) || params.tolerance <= 0)
+    return Error{Status::invalid_argument, "normalize tolerance: must be > 0"};
+  NormalizedMesh out;
+  TriangleMesh m = mesh;
+  std::vector<Vec3> image(m.vertices.size());
+  for (std::size_t v = 0; v < m.vertices.size(); ++v) image[v] = mapped(field, m.vertices[v]);
+
+  for (int round = 0; round < params.max_rounds; ++round) {
+    if (ctx.cancelled()) return Error{Status::cancelled, "cancelled"};
+    // Decide per edge once; the midpoint index is shared by both faces (conforming).
+    std::unordered_map<std::uint64_t, int> mid;
+    mid.reserve(m.faces.size());
+    for (const auto& f : m.faces)
+      for (int k = 0; k < 3; ++k) {
+        const int a = f[k], b = f[(k + 1) % 3];
+        const std::uint64_t key = edge_key(a, b);
+        if (mid.count(key)) continue;
+        const Vec3 pm = 0.5 * (m.vertices[a] + m.vertices[b]);
+        const Vec3 im = mapped(field, pm);
+        if ((im - 0.5 * (image[a] + image[b])).norm() <= params.tolerance) {
+          mid.emplace(key, -1);
+          continue;
+        }
+        mid.emplace(key, static_cast<int>(m.vertices.size()));
+        m.vertices.push_back(pm);
+        image.push_back(im);
+      }
+    std::size_t split = 0;
+    std::vector<std::array<int, 3>> faces;
+    faces.reserve(m.faces.size());
+    for (const auto& f : m.faces) {
+      int e[3];
+      int n = 0;
+      for (int k = 0; k < 3; ++k) n += (e[k] = mid[edge_key(f[k], f[(k + 1) % 3])]) >= 0;
+      if (n == 0) {
+        faces.push_back(f);
+      } else if (n == 1) {
+        const int k = e[0] >= 0 ? 0 : e[1] >= 0 ? 1 : 2;  // split edge f[k] → f[k+1]
+        const int a = f[k], b = f[(k + 1) % 3], c = f[(k + 2) % 3], mab = e[k];
+        faces.push_back({a, mab, c});
+        faces.push_back({mab, b, c});
+      } else if (n == 2) {
+        const int u = e[0] < 0 ? 0 : e[1] < 0 ? 1 : 2;  // the edge that stays whole: a → b
+        const int a = f[u], b = f[(u + 1) % 3], c = f[(u + 2) % 3];
+        const int mbc = e[(u + 1) % 3], mca = e[(u + 2) % 3];
+        faces.push_back({a, b, mbc});
+        faces.push_back({a, mbc, mca});
+        faces.push_back({mca, mbc, c});
+      } else {
+        const int a = f[0], b = f[1], c = f[2], mab = e[0], mbc = e[1], mca = e[2];
+        faces.push_back({a, mab, mca});
+        faces.push_back({mab, b, mbc});
+        faces.push_back({mca, mbc, c});
+        faces.push_back({mab, mbc, mca});
+      }
+    }
+    for (const auto& [key, v] : mid) split += v >= 0;
+    m.faces = std::move(faces);
+    out.rounds = round + 1;
+    out.edges_split += split;
+    ctx.progress("normalize", std::min(1.0, 0.1 * (round + 1)));
+    if (split == 0) break;
+  }
+  m.vertices = std::move(image);
+  out.mesh = std::move(m);
+  return out;
+}
+
+}  // namespace nonplanar

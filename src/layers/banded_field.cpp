@@ -1,0 +1,140 @@
+#include "layers/banded_field.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "nurbs/bspline_basis.hpp"
+
+namespace nonplanar::layers {
+namespace {
+
+double smoothstep(double t) {
+  t = std::clamp(t, 0.0, 1.0);
+  return t * t * (3 - 2 * t);
+}
+
+// Uniform cubic B-spline basis at fraction t for nodes i−1 … i+2.
+void cubic_weights(double t, double* w) {
+  const double s = 1 - t;
+  w[0] = s * s * s / 6;
+  w[1] = (3 * t * t * t - 6 * t * t + 4) / 6;
+  w[2] = (-3 * t * t * t + 3 * t * t + 3 * t + 1) / 6;
+  w[3] = t * t * t / 6;
+}
+
+}  // namespace
+
+void Band::heights(double x, double y, double* S) const {
+  const NurbsSurface& s = top.surface;
+  const Vec2 uv = top.uv(x, y);
+  const double u = std::clamp(uv.x(), 0.0, 1.0), v = std::clamp(uv.y(), 0.0, 1.0);
+  const int su = nurbs::find_span(s.n_u, s.p, u, s.U), sv = nurbs::find_span(s.n_v, s.q, v, s.V);
+  double Nu[8], Nv[8], R[64];
+  nurbs::basis_funs(su, u, s.p, s.U, Nu);
+  nurbs::basis_funs(sv, v, s.q, s.V, Nv);
+  double W = 0;
+  for (int a = 0; a <= s.p; ++a)
+    for (int c2 = 0; c2 <= s.q; ++c2) {
+      R[a * (s.q + 1) + c2] = Nu[a] * Nv[c2] * s.w(su - s.p + a, sv - s.q + c2);
+      W += R[a * (s.q + 1) + c2];
+    }
+  for (int i = 0; i <= N; ++i) {
+    double z = 0;
+    for (int a = 0; a <= s.p; ++a)
+      for (int c2 = 0; c2 <= s.q; ++c2)
+        z += R[a * (s.q + 1) + c2] * Z(i, (su - s.p + a) * s.n_v + (sv - s.q + c2));
+    S[i] = z / W;
+  }
+}
+
+double Band::beta(double x, double y) const {
+  const double fx = (x - blend_origin.x()) / blend_cell, fy = (y - blend_origin.y()) / blend_cell;
+  const int i = static_cast<int>(std::floor(fx)), j = static_cast<int>(std::floor(fy));
+  if (i < -2 || j < -2 || i > blend_nx || j > blend_ny) return 0.0;
+  double wx[4], wy[4];
+  cubic_weights(fx - i, wx);
+  cubic_weights(fy - j, wy);
+  double b = 0;
+  for (int a = 0; a < 4; ++a) {
+    const int ii = i - 1 + a;
+    if (ii < 0 || ii >= blend_nx) continue;
+    for (int c2 = 0; c2 < 4; ++c2) {
+      const int jj = j - 1 + c2;
+      if (jj < 0 || jj >= blend_ny) continue;
+      b += wx[a] * wy[c2] * blend[static_cast<std::size_t>(ii) * blend_ny + jj];
+    }
+  }
+  return b;
+}
+
+double Band::delta(double x, double y, double z, const PlanarLayers& pl) const {
+  if (z <= c) return 0.0;
+  double S[512];
+  heights(x, y, S);
+  if (z <= S[0]) {
+    int i = 0;
+    while (i + 1 < N && S[i + 1] > z) ++i;  // S decreases with i: S[i] ≥ z ≥ S[i+1]
+    const double gap = S[i] - S[i + 1];
+    const double s = i + (gap > 0 ? std::clamp((S[i] - z) / gap, 0.0, 1.0) : 0.0);
+    return (T_bottom + N - s) - pl.T(z);
+  }
+  const double d0 = (T_bottom + N) - pl.T(S[0]);
+  return d0 * (1.0 - smoothstep((z - S[0]) / fade));
+}
+
+void set_blend(Band& b, const PatchRaster& r, double blend) {
+  b.blend_origin = r.origin;
+  b.blend_cell = r.cell;
+  b.blend_nx = r.nx;
+  b.blend_ny = r.ny;
+  b.blend.resize(r.dist.size());
+  const double inner = 3.0 * r.cell;
+  for (std::size_t k = 0; k < r.dist.size(); ++k)
+    b.blend[k] = 1.0 - smoothstep((r.dist[k] - inner) / blend);
+}
+
+double BandedField::T(double x, double y, double z) const {
+  double beta[64], sum = 0;
+  const std::size_t nb = std::min<std::size_t>(bands_.size(), 64);
+  for (std::size_t b = 0; b < nb; ++b) sum += beta[b] = bands_[b].beta(x, y);
+  const double scale = sum > 1.0 ? 1.0 / sum : 1.0;
+  double t = pl_.T(z);
+  for (std::size_t b = 0; b < nb; ++b)
+    if (beta[b] > 0) t += scale * beta[b] * bands_[b].delta(x, y, z, pl_);
+  return t;
+}
+
+double BandedField::z_at(double x, double y, double t) const {
+  // T increases in z: bracket around the planar guess, then bisection with a secant step
+  // (Illinois) to 1e-10 mm.
+  const double z0 = pl_.zeta(t);
+  double lo = z0 - 1.0, hi = z0 + 1.0;
+  double flo = T(x, y, lo) - t, fhi = T(x, y, hi) - t;
+  for (int k = 0; flo > 0 && k < 60; ++k) lo -= (hi - lo), flo = T(x, y, lo) - t;
+  for (int k = 0; fhi < 0 && k < 60; ++k) hi += (hi - lo), fhi = T(x, y, hi) - t;
+  int side = 0;
+  for (int it = 0; it < 200 && hi - lo > 1e-10; ++it) {
+    double z = (lo * fhi - hi * flo) / (fhi - flo);
+    if (!(z > lo && z < hi)) z = 0.5 * (lo + hi);
+    const double f = T(x, y, z) - t;
+    if (f == 0) return z;
+    if ((f < 0) == (flo < 0)) {
+      lo = z, flo = f;
+      if (side == -1) fhi *= 0.5;
+      side = -1;
+    } else {
+      hi = z, fhi = f;
+      if (side == 1) flo *= 0.5;
+      side = 1;
+    }
+  }
+  return 0.5 * (lo + hi);
+}
+
+double BandedField::thickness(double x, double y, double z) const {
+  const double e = 1e-5;
+  const double d = (T(x, y, z + e) - T(x, y, z - e)) / (2 * e);
+  return d > 0 ? 1.0 / d : 1e300;
+}
+
+}  // namespace nonplanar::layers

@@ -1,0 +1,57 @@
+// The layer field of DESIGN.md §2 step 4: T = T_p(z) + Σ_b β_b(x, y) δ_b(x, y, z).
+//
+// Notation: T_p the planar coordinate; for band b (one accepted stack), δ_b = T_b − T_p where
+// T_b is the stack's own coordinate (T_bottom + N − s, s the fractional layer index between
+// the stack surfaces at (x, y)); above the top S_0, δ_b fades to 0 over L_rec with a
+// smoothstep; below c it is 0. β_b ∈ [0, 1] is a uniform cubic B-spline over a raster
+// (C²), exactly 1 on the patch, 0 beyond the blend distance; where Σβ > 1 the β are scaled
+// to sum to 1, so T stays a convex combination of increasing functions of z.
+#pragma once
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "layers/patch_raster.hpp"
+#include "layers/planar_layers.hpp"
+#include "nonplanar/layers.hpp"
+
+namespace nonplanar::layers {
+
+struct Band {
+  HeightField top;    ///< knots, weights and (x, y) map shared by the stack
+  Eigen::MatrixXd Z;  ///< (N + 1) × controls: control heights of S_0 … S_N
+  double c = 0, T_bottom = 0;
+  int N = 0;
+  double fade = 1.0;  ///< L_rec, mm
+  // β: cubic B-spline control values on a grid (origin = node (0, 0)).
+  Vec2 blend_origin{0, 0};
+  double blend_cell = 0.5;
+  int blend_nx = 0, blend_ny = 0;
+  std::vector<double> blend;
+
+  /// S_0 … S_N at (x, y) into S (size N + 1).
+  void heights(double x, double y, double* S) const;
+  double beta(double x, double y) const;
+  double delta(double x, double y, double z, const PlanarLayers& pl) const;
+};
+
+/// β control values from a patch raster: 1 within 3 nodes of the patch (so the B-spline is
+/// exactly 1 on it), then 1 − smoothstep over `blend` mm.
+void set_blend(Band& b, const PatchRaster& r, double blend);
+
+class BandedField final : public LayerField {
+ public:
+  BandedField(PlanarLayers pl, std::vector<Band> bands) : pl_(pl), bands_(std::move(bands)) {}
+  double T(double x, double y, double z) const override;
+  double z_at(double x, double y, double t) const override;
+  double zeta(double t) const override { return pl_.zeta(t); }
+  double t_of_zeta(double z) const override { return pl_.t_of_zeta(z); }
+  double thickness(double x, double y, double z) const override;
+  const std::vector<Band>& bands() const { return bands_; }
+
+ private:
+  PlanarLayers pl_;
+  std::vector<Band> bands_;
+};
+
+}  // namespace nonplanar::layers

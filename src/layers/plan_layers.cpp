@@ -1,0 +1,167 @@
+// plan_layers: stacks per patch, then the field, then a check of the blend zones inside the
+// material; a patch whose blend breaks a limit is dropped to planar and the field rebuilt.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <optional>
+
+#include "core/column_caster.hpp"
+#include "layers/banded_field.hpp"
+#include "layers/stack_builder.hpp"
+
+namespace nonplanar {
+namespace {
+
+using layers::Band;
+using layers::BandedField;
+using layers::PlanarLayers;
+
+std::optional<Error> check(const LayerParams& p) {
+  auto bad = [](const char* key, const std::string& why) {
+    return Error{Status::invalid_argument, std::string(key) + ": " + why};
+  };
+  auto pos = [](double v) { return std::isfinite(v) && v > 0; };
+  if (!pos(p.layer_height)) return bad("layer_height", "must be a finite number > 0");
+  if (!pos(p.first_layer_height)) return bad("first_layer_height", "must be a finite number > 0");
+  if (!pos(p.min_layer_height)) return bad("min_layer_height", "must be a finite number > 0");
+  if (!pos(p.max_layer_height)) return bad("max_layer_height", "must be a finite number > 0");
+  if (p.min_layer_height > p.max_layer_height)
+    return bad("min_layer_height", "is greater than max_layer_height");
+  if (p.layer_height < p.min_layer_height || p.layer_height > p.max_layer_height)
+    return bad("layer_height", "must lie in [min_layer_height, max_layer_height]");
+  if (!std::isfinite(p.max_angle_deg) || p.max_angle_deg <= 0 || p.max_angle_deg >= 90)
+    return bad("max_angle", "must be in (0, 90) degrees");
+  if (!pos(p.block_radius) || !pos(p.block_clearance) || !pos(p.nozzle_tip_radius))
+    return bad("block_radius/block_clearance/nozzle_tip_radius", "must be finite numbers > 0");
+  if (!std::isfinite(p.nozzle_angle_deg) || p.nozzle_angle_deg <= 0 || p.nozzle_angle_deg >= 90)
+    return bad("nozzle_angle", "must be in (0, 90) degrees");
+  if (!std::isfinite(p.continuity_weight) || p.continuity_weight < 0)
+    return bad("continuity_weight", "must be >= 0");
+  if (!pos(p.grid_step)) return bad("grid_step", "must be > 0");
+  if (p.max_iterations < 0) return bad("max_iterations", "must be >= 0");
+  return std::nullopt;
+}
+
+// Layers through the blend zone of band `b` (0 < β < 1) where there is material: thickness
+// and slope. Returns a reason, or empty.
+std::string check_blend(const BandedField& field, const Band& b, const ColumnCaster& columns,
+                        const LayerParams& p) {
+  const double step = 1.0;
+  const int stride = std::max(1, static_cast<int>(step / b.blend_cell));
+  double top_max = -1e300;
+  double S[512];
+  // Columns: every stride-th node of the blend raster.
+  std::map<std::pair<int, int>, std::vector<double>> zk;  // layer boundary heights per column
+  const double T0 = b.T_bottom;
+  std::vector<std::pair<int, int>> cols;
+  for (int i = 0; i < b.blend_nx; i += stride)
+    for (int j = 0; j < b.blend_ny; j += stride) {
+      const double x = b.blend_origin.x() + i * b.blend_cell,
+                   y = b.blend_origin.y() + j * b.blend_cell;
+      const double beta = b.beta(x, y);
+      if (beta <= 0 || beta >= 1) continue;
+      b.heights(x, y, S);
+      top_max = std::max(top_max, S[0]);
+      cols.emplace_back(i, j);
+    }
+  if (cols.empty()) return {};
+  const int k_hi = static_cast<int>(std::ceil(field.t_of_zeta(top_max + b.fade))) + 1;
+  for (const auto& [i, j] : cols) {
+    const double x = b.blend_origin.x() + i * b.blend_cell,
+                 y = b.blend_origin.y() + j * b.blend_cell;
+    const auto iv = columns.intervals(x, y);
+    if (iv.empty()) continue;
+    std::vector<double> z;
+    for (int k = static_cast<int>(T0); k <= k_hi; ++k) z.push_back(field.z_at(x, y, k));
+    for (std::size_t k = 0; k + 1 < z.size(); ++k) {
+      const double mid = 0.5 * (z[k] + z[k + 1]);
+      bool in = false;
+      for (const auto& [lo, hi] : iv) in |= mid > lo && mid < hi;
+      if (!in) continue;
+      const double t = z[k + 1] - z[k];
+      if (t < p.min_layer_height - 1e-4 || t > p.max_layer_height + 1e-4) {
+        char buf[200];
+        std::snprintf(buf, sizeof buf,
+                      "blending into the planar layers makes a %.3f mm layer at x = %.2f, y = %.2f",
+                      t, x, y);
+        return buf;
+      }
+    }
+    zk[{i, j}] = std::move(z);
+  }
+  // Slopes between neighbouring columns that both have material at that layer.
+  const double tmax = std::tan((p.max_angle_deg + 0.5) * M_PI / 180.0);
+  for (const auto& [ij, z] : zk) {
+    for (const auto& nb :
+         {std::pair{ij.first + stride, ij.second}, std::pair{ij.first, ij.second + stride}}) {
+      const auto it = zk.find(nb);
+      if (it == zk.end()) continue;
+      const double d = stride * b.blend_cell;
+      for (std::size_t k = 0; k < std::min(z.size(), it->second.size()); ++k)
+        if (std::abs(it->second[k] - z[k]) / d > tmax * 1.02) {
+          const double x = b.blend_origin.x() + ij.first * b.blend_cell;
+          char buf[200];
+          std::snprintf(buf, sizeof buf,
+                        "blending into the planar layers tilts a layer to %.1f deg near x = %.2f",
+                        std::atan(std::abs(it->second[k] - z[k]) / d) * 180 / M_PI, x);
+          return buf;
+        }
+    }
+  }
+  return {};
+}
+
+}  // namespace
+
+std::shared_ptr<const LayerField> planar_field(const LayerParams& p) {
+  return std::make_shared<BandedField>(PlanarLayers{p.first_layer_height, p.layer_height},
+                                       std::vector<Band>{});
+}
+
+Expected<LayerPlan> plan_layers(const TriangleMesh& mesh, const Analysis& analysis,
+                                const std::vector<SurfaceFit>& fits,
+                                const std::vector<int>& patch_of_fit, const LayerParams& params,
+                                const Context& ctx) {
+  if (auto e = check(params)) return *e;
+  if (fits.size() != patch_of_fit.size())
+    return Error{Status::invalid_argument, "plan_layers: one patch index per fit expected"};
+  const PlanarLayers planar{params.first_layer_height, params.layer_height};
+  const ColumnCaster columns(mesh);
+  LayerPlan plan;
+  std::vector<Band> bands;
+  for (std::size_t i = 0; i < fits.size(); ++i) {
+    if (ctx.cancelled()) return Error{Status::cancelled, "cancelled"};
+    const int pid = patch_of_fit[i];
+    if (pid < 0 || pid >= static_cast<int>(analysis.patches.size()))
+      return Error{Status::invalid_argument, "plan_layers: patch index out of range"};
+    auto r = layers::build_stack(mesh, analysis.patches[pid], pid, fits[i].surface, columns, params,
+                                 planar);
+    if (!r.failure.empty()) {
+      plan.fallbacks.push_back({pid, r.failure});
+    } else {
+      plan.stacks.push_back(std::move(r.stack));
+      bands.push_back(std::move(r.band));
+    }
+    ctx.progress("layers", 0.8 * static_cast<double>(i + 1) / static_cast<double>(fits.size()));
+  }
+  // Check each blend zone in the field of all bands; drop offenders until none is left.
+  for (bool changed = true; changed;) {
+    changed = false;
+    const BandedField field(planar, bands);
+    for (std::size_t b = 0; b < bands.size(); ++b) {
+      const std::string why = check_blend(field, bands[b], columns, params);
+      if (why.empty()) continue;
+      plan.fallbacks.push_back({plan.stacks[b].patch, why});
+      plan.stacks.erase(plan.stacks.begin() + static_cast<long>(b));
+      bands.erase(bands.begin() + static_cast<long>(b));
+      changed = true;
+      break;
+    }
+  }
+  plan.field = std::make_shared<BandedField>(planar, std::move(bands));
+  ctx.progress("layers", 1.0);
+  return plan;
+}
+
+}  // namespace nonplanar

@@ -1,0 +1,121 @@
+#include "layers/printability_cost.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "nurbs/bspline_basis.hpp"
+
+namespace nonplanar::layers {
+
+int StackGrid::control(int k, int a) const {
+  const int i0 = first[k] / n_v, j0 = first[k] % n_v;
+  return (i0 + a / (q + 1)) * n_v + (j0 + a % (q + 1));
+}
+
+void build_stack_grid(StackGrid& g, const HeightField& hf, double step,
+                      const std::vector<char>& raster_mask, const Vec2& raster_origin,
+                      double raster_cell, int raster_nx, int raster_ny) {
+  const NurbsSurface& s = hf.surface;
+  g = StackGrid{};
+  g.n_u = s.n_u, g.n_v = s.n_v, g.q = s.q;
+  g.m = (s.p + 1) * (s.q + 1);
+  const int nx = std::max(2, static_cast<int>(std::ceil(hf.extent.x() / step)));
+  const int ny = std::max(2, static_cast<int>(std::ceil(hf.extent.y() / step)));
+  const double dx = hf.extent.x() / nx, dy = hf.extent.y() / ny;
+  g.nx = nx, g.ny = ny, g.step_x = dx, g.step_y = dy;
+  std::vector<double> du(2 * (s.p + 1)), dv(2 * (s.q + 1));
+  for (int i = 0; i < nx; ++i)
+    for (int j = 0; j < ny; ++j) {
+      const double x = hf.origin.x() + (i + 0.5) * dx, y = hf.origin.y() + (j + 0.5) * dy;
+      const int ri = static_cast<int>(std::lround((x - raster_origin.x()) / raster_cell));
+      const int rj = static_cast<int>(std::lround((y - raster_origin.y()) / raster_cell));
+      const bool on = ri >= 0 && rj >= 0 && ri < raster_nx && rj < raster_ny &&
+                      raster_mask[static_cast<std::size_t>(ri) * raster_ny + rj];
+      g.xy.emplace_back(x, y);
+      g.area.push_back(dx * dy);
+      g.on_patch.push_back(on);
+      const Vec2 uv = hf.uv(x, y);
+      const int su = nurbs::find_span(s.n_u, s.p, uv.x(), s.U);
+      const int sv = nurbs::find_span(s.n_v, s.q, uv.y(), s.V);
+      nurbs::ders_basis_funs(su, uv.x(), s.p, 1, s.U, du.data());
+      nurbs::ders_basis_funs(sv, uv.y(), s.q, 1, s.V, dv.data());
+      g.first.push_back((su - s.p) * s.n_v + (sv - s.q));
+      // Rational basis R = N w / W and its derivatives (quotient rule), in x and y.
+      double W = 0, Wu = 0, Wv = 0;
+      for (int a = 0; a <= s.p; ++a)
+        for (int c = 0; c <= s.q; ++c) {
+          const double w = s.w(su - s.p + a, sv - s.q + c);
+          W += du[a] * dv[c] * w;
+          Wu += du[s.p + 1 + a] * dv[c] * w;
+          Wv += du[a] * dv[s.q + 1 + c] * w;
+        }
+      for (int a = 0; a <= s.p; ++a)
+        for (int c = 0; c <= s.q; ++c) {
+          const double w = s.w(su - s.p + a, sv - s.q + c);
+          const double N = du[a] * dv[c] * w, Nu = du[s.p + 1 + a] * dv[c] * w,
+                       Nv = du[a] * dv[s.q + 1 + c] * w;
+          g.R.push_back(N / W);
+          g.Rx.push_back((Nu * W - N * Wu) / (W * W) / hf.extent.x());
+          g.Ry.push_back((Nv * W - N * Wv) / (W * W) / hf.extent.y());
+        }
+    }
+}
+
+double printability_cost(const StackGrid& g, const Eigen::MatrixXd& Z, const CostTerms& c,
+                         Eigen::MatrixXd* grad) {
+  const int L = static_cast<int>(Z.rows());  // N + 1 surfaces
+  const int n = static_cast<int>(g.xy.size());
+  if (grad) grad->setZero(L - 2 > 0 ? L - 2 : 0, Z.cols());
+  double cost = 0;
+  std::vector<double> S(L), Sx(L), Sy(L), dS(L), dSx(L), dSy(L);
+  for (int k = 0; k < n; ++k) {
+    const double* R = &g.R[static_cast<std::size_t>(k) * g.m];
+    const double* Rx = &g.Rx[static_cast<std::size_t>(k) * g.m];
+    const double* Ry = &g.Ry[static_cast<std::size_t>(k) * g.m];
+    for (int i = 0; i < L; ++i) {
+      double s = 0, sx = 0, sy = 0;
+      for (int a = 0; a < g.m; ++a) {
+        const double z = Z(i, g.control(k, a));
+        s += R[a] * z, sx += Rx[a] * z, sy += Ry[a] * z;
+      }
+      S[i] = s, Sx[i] = sx, Sy[i] = sy;
+      dS[i] = dSx[i] = dSy[i] = 0;
+    }
+    const double ak = g.area[k];
+    const bool on = g.on_patch[k];
+    for (int i = 0; i + 1 < L; ++i) {
+      const double t = S[i] - S[i + 1];
+      double dt = 0;  // ∂C/∂t
+      if (on) {
+        cost += ak * (t - c.h) * (t - c.h);
+        dt += 2 * ak * (t - c.h);
+        const double ex = Sx[i] - Sx[i + 1], ey = Sy[i] - Sy[i + 1];
+        cost += ak * c.lambda * (ex * ex + ey * ey);
+        dSx[i] += 2 * ak * c.lambda * ex, dSx[i + 1] -= 2 * ak * c.lambda * ex;
+        dSy[i] += 2 * ak * c.lambda * ey, dSy[i + 1] -= 2 * ak * c.lambda * ey;
+      }
+      if (t < c.h_min)
+        cost += ak * c.mu * (c.h_min - t) * (c.h_min - t), dt -= 2 * ak * c.mu * (c.h_min - t);
+      if (t > c.h_max)
+        cost += ak * c.mu * (t - c.h_max) * (t - c.h_max), dt += 2 * ak * c.mu * (t - c.h_max);
+      dS[i] += dt, dS[i + 1] -= dt;
+    }
+    for (int i = 1; i + 1 < L; ++i) {  // the top is fixed (the part) and the bottom is flat
+      const double sl = std::hypot(Sx[i], Sy[i]);
+      if (sl > c.g) {
+        cost += ak * c.mu * (sl - c.g) * (sl - c.g);
+        const double f = 2 * ak * c.mu * (sl - c.g) / sl;
+        dSx[i] += f * Sx[i], dSy[i] += f * Sy[i];
+      }
+    }
+    if (!grad) continue;
+    for (int i = 1; i + 1 < L; ++i) {
+      if (dS[i] == 0 && dSx[i] == 0 && dSy[i] == 0) continue;
+      for (int a = 0; a < g.m; ++a)
+        (*grad)(i - 1, g.control(k, a)) += dS[i] * R[a] + dSx[i] * Rx[a] + dSy[i] * Ry[a];
+    }
+  }
+  return cost;
+}
+
+}  // namespace nonplanar::layers

@@ -1,0 +1,49 @@
+// The printability cost of a layer stack (paper eq. 1, plus the printer's slope and heater-
+// block limits) and its analytic gradient with respect to the intermediate layers' control
+// heights.
+//
+// Notation: samples k on a grid over the stack's rectangle, area a_k; R_kj the rational basis
+// of control point j at sample k (all layers share knots and weights, so S_i(k) = Σ_j R_kj
+// z_ij and ∇S_i(k) = Σ_j ∇R_kj z_ij); t_ik = S_i(k) − S_{i+1}(k).
+//   C = Σ_k a_k [ m_k Σ_i (t_ik − h)²                       (eq. 1, squared: smooth)
+//               + m_k λ Σ_i |∇S_i − ∇S_{i+1}|²            (continuity)
+//               + μ Σ_i (max(0, h_min − t)² + max(0, t − h_max)²)
+//               + μ Σ_i max(0, |∇S_i| − g)² ]            (slope: g = min(tan α, H/R))
+// with m_k = 1 on the patch, 0 in the margin around it (limits hold there too).
+#pragma once
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "nonplanar/layers.hpp"
+
+namespace nonplanar::layers {
+
+struct StackGrid {
+  std::vector<Vec2> xy;
+  std::vector<double> area;
+  std::vector<char> on_patch;
+  int m = 0;                      ///< basis functions per sample, (p+1)(q+1)
+  std::vector<int> first;         ///< per sample: (i0, j0) of its span as i0·n_v + j0
+  std::vector<double> R, Rx, Ry;  ///< m per sample: basis, ∂/∂x, ∂/∂y
+  int n_u = 0, n_v = 0, q = 0;
+  int nx = 0, ny = 0;  ///< sample k = i·ny + j at (i + ½, j + ½)·step
+  double step_x = 0, step_y = 0;
+
+  int control(int k, int a) const;  ///< control index of the a-th basis function of sample k
+};
+
+struct CostTerms {
+  double h, h_min, h_max, lambda, mu, g;
+};
+
+/// Cost of the stack with control heights Z (layers × controls, row-major); if grad is
+/// non-null, its gradient for the intermediate layers 1..N−1 ((N−1) × controls).
+double printability_cost(const StackGrid& grid, const Eigen::MatrixXd& Z, const CostTerms& c,
+                         Eigen::MatrixXd* grad);
+
+void build_stack_grid(StackGrid& g, const HeightField& s, double step,
+                      const std::vector<char>& raster_mask, const Vec2& raster_origin,
+                      double raster_cell, int raster_nx, int raster_ny);
+
+}  // namespace nonplanar::layers

@@ -1,0 +1,301 @@
+#include "layers/stack_builder.hpp"
+
+#include <ceres/gradient_problem.h>
+#include <ceres/gradient_problem_solver.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "layers/printability_cost.hpp"
+
+namespace nonplanar::layers {
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+
+std::string fmt2(const char* f, double a, double b) {
+  char buf[160];
+  std::snprintf(buf, sizeof buf, f, a, b);
+  return buf;
+}
+
+class StackObjective final : public ceres::FirstOrderFunction {
+ public:
+  StackObjective(const StackGrid& g, const Eigen::MatrixXd& Z, const CostTerms& c)
+      : g_(g), Z_(Z), c_(c) {}
+  int NumParameters() const override { return static_cast<int>((Z_.rows() - 2) * Z_.cols()); }
+  bool Evaluate(const double* x, double* cost, double* gradient) const override {
+    Eigen::MatrixXd Z = Z_;
+    const int n = static_cast<int>(Z.cols());
+    for (int i = 1; i + 1 < Z.rows(); ++i)
+      for (int j = 0; j < n; ++j) Z(i, j) = x[(i - 1) * n + j];
+    Eigen::MatrixXd grad;
+    *cost = printability_cost(g_, Z, c_, gradient ? &grad : nullptr);
+    if (gradient)
+      for (int i = 0; i < grad.rows(); ++i)
+        for (int j = 0; j < n; ++j) gradient[i * n + j] = grad(i, j);
+    return std::isfinite(*cost);
+  }
+
+ private:
+  const StackGrid& g_;
+  const Eigen::MatrixXd& Z_;
+  CostTerms c_;
+};
+
+struct Figures {
+  double t_min = 1e300, t_max = -1e300, slope = 0, rise = 0;
+};
+
+// Thickness and slope over the patch's samples; rise of each layer within the block radius
+// on a grid of about 1 mm.
+Figures measure(const StackGrid& g, const Eigen::MatrixXd& Z, const LayerParams& p) {
+  Figures f;
+  const int L = static_cast<int>(Z.rows());
+  const int n = static_cast<int>(g.xy.size());
+  std::vector<std::vector<double>> S(L, std::vector<double>(n));
+  for (int k = 0; k < n; ++k) {
+    for (int i = 0; i < L; ++i) {
+      double s = 0, sx = 0, sy = 0;
+      for (int a = 0; a < g.m; ++a) {
+        const double z = Z(i, g.control(k, a));
+        s += g.R[k * g.m + a] * z, sx += g.Rx[k * g.m + a] * z, sy += g.Ry[k * g.m + a] * z;
+      }
+      S[i][k] = s;
+      if (g.on_patch[k]) f.slope = std::max(f.slope, std::atan(std::hypot(sx, sy)) / kDeg);
+    }
+    if (!g.on_patch[k]) continue;
+    for (int i = 0; i + 1 < L; ++i) {
+      f.t_min = std::min(f.t_min, S[i][k] - S[i + 1][k]);
+      f.t_max = std::max(f.t_max, S[i][k] - S[i + 1][k]);
+    }
+  }
+  // Rise within the block radius, on a 2D subgrid of about 1 mm: for each patch point p,
+  // the highest point q of the same layer in the disk around it (precomputed offsets).
+  const int sx = std::max(1, static_cast<int>(std::lround(1.0 / g.step_x)));
+  const int sy = std::max(1, static_cast<int>(std::lround(1.0 / g.step_y)));
+  std::vector<std::pair<int, int>> disk;
+  const int rx = static_cast<int>(p.block_radius / (sx * g.step_x));
+  const int ry = static_cast<int>(p.block_radius / (sy * g.step_y));
+  for (int di = -rx; di <= rx; ++di)
+    for (int dj = -ry; dj <= ry; ++dj)
+      if (std::hypot(di * sx * g.step_x, dj * sy * g.step_y) <= p.block_radius)
+        disk.emplace_back(di * sx, dj * sy);
+  for (int i = 0; i < L; ++i)
+    for (int a = 0; a < g.nx; a += sx)
+      for (int b = 0; b < g.ny; b += sy) {
+        const int k = a * g.ny + b;
+        if (!g.on_patch[k]) continue;
+        for (const auto& [di, dj] : disk) {
+          const int a2 = a + di, b2 = b + dj;
+          if (a2 < 0 || b2 < 0 || a2 >= g.nx || b2 >= g.ny) continue;
+          const int k2 = a2 * g.ny + b2;
+          if (g.on_patch[k2]) f.rise = std::max(f.rise, S[i][k2] - S[i][k]);
+        }
+      }
+  return f;
+}
+
+}  // namespace
+
+StackResult build_stack(const TriangleMesh& mesh, const Patch& patch, int patch_id,
+                        const HeightField& top, const ColumnCaster& columns, const LayerParams& p,
+                        const PlanarLayers& planar, double initial_power) {
+  StackResult out;
+  LayerStack& st = out.stack;
+  st.patch = patch_id;
+  st.xy_min = patch.xy_min;
+  st.xy_max = patch.xy_max;
+  const PatchRaster raster = rasterize_patch(mesh, patch, std::max(0.1, p.grid_step / 2), 0.0);
+  // Figures on a fine grid; the optimiser's quadrature on one of about 40 × 40 points.
+  StackGrid grid, coarse;
+  const double step = std::max(p.grid_step, std::max(top.extent.x(), top.extent.y()) / 100.0);
+  build_stack_grid(grid, top, step, raster.mask, raster.origin, raster.cell, raster.nx, raster.ny);
+  // ... but at least two samples per knot span, or the layers could wiggle between samples.
+  double span = 1e300;
+  for (std::size_t i = 0; i + 1 < top.surface.U.size(); ++i)
+    if (top.surface.U[i + 1] > top.surface.U[i])
+      span = std::min(span, (top.surface.U[i + 1] - top.surface.U[i]) * top.extent.x());
+  for (std::size_t i = 0; i + 1 < top.surface.V.size(); ++i)
+    if (top.surface.V[i + 1] > top.surface.V[i])
+      span = std::min(span, (top.surface.V[i + 1] - top.surface.V[i]) * top.extent.y());
+  const double coarse_step =
+      std::max(step, std::min(std::max(top.extent.x(), top.extent.y()) / 40.0, span / 2.0));
+  build_stack_grid(coarse, top, coarse_step, raster.mask, raster.origin, raster.cell, raster.nx,
+                   raster.ny);
+
+  // Heights of the top over the whole rectangle (the stack must be valid where it blends).
+  const int n = static_cast<int>(grid.xy.size());
+  std::vector<double> top_z(n);
+  double zmin = 1e300, zmax = -1e300, on_sum = 0, top_slope = 0;
+  int on_count = 0;
+  for (int k = 0; k < n; ++k) {
+    top_z[k] = top.height(grid.xy[k].x(), grid.xy[k].y());
+    zmin = std::min(zmin, top_z[k]);
+    zmax = std::max(zmax, top_z[k]);
+    if (grid.on_patch[k]) {
+      on_sum += top_z[k], ++on_count;
+      top_slope = std::max(top_slope,
+                           std::atan(top.gradient(grid.xy[k].x(), grid.xy[k].y()).norm()) / kDeg);
+    }
+  }
+  if (on_count == 0) {
+    out.failure = "patch covers no sample of its grid";
+    return out;
+  }
+  if (top_slope > p.max_angle_deg + 0.5) {
+    out.failure =
+        fmt2("surface slope %.1f deg exceeds max_angle %.1f deg", top_slope, p.max_angle_deg);
+    return out;
+  }
+  // c: deep enough that (relief + d) / d ≤ h_max / h_min, on a planar boundary.
+  const double relief = zmax - zmin;
+  const double ratio = p.max_layer_height / p.min_layer_height;
+  const double d_req = std::max(relief / (ratio - 1.0) * 1.15, 2 * p.min_layer_height);
+  const double c_max = zmin - d_req;
+  const double k = std::floor((c_max - p.first_layer_height) / p.layer_height + 1e-9);
+  if (k < 0) {
+    out.failure = fmt2("needs %.2f mm of part below the patch's lowest point, has %.2f mm",
+                       d_req + p.first_layer_height, zmin);
+    return out;
+  }
+  st.c = p.first_layer_height + k * p.layer_height;
+  st.T_bottom = planar.T(st.c);
+  const double D_min = zmin - st.c, D_max = zmax - st.c, D_mean = on_sum / on_count - st.c;
+  int N = static_cast<int>(std::lround(D_mean / p.layer_height));
+  N = std::max(N, static_cast<int>(std::ceil(D_max / (0.97 * p.max_layer_height))));
+  N = std::min(N, static_cast<int>(std::floor(D_min / (1.03 * p.min_layer_height))));
+  if (N < 1 || D_max / N > p.max_layer_height || D_min / N < p.min_layer_height || N > 500) {
+    out.failure = fmt2(
+        "relief %.2f mm cannot be split into layers within the thickness limits "
+        "(%.2f mm below the patch)",
+        relief, D_min);
+    return out;
+  }
+  st.layers = N;
+  // Material: solid from c up to the top under the patch, nothing just above it.
+  for (int kk = 0; kk < n; ++kk) {
+    if (!grid.on_patch[kk]) continue;
+    const double x = grid.xy[kk].x(), y = grid.xy[kk].y();
+    bool meets_top = false, solid = false, above = false;
+    for (const auto& [lo, hi] : columns.intervals(x, y)) {
+      // The interval whose top is the patch (the fit is within a fraction of a mm).
+      if (hi >= top_z[kk] - 0.05 && hi <= top_z[kk] + 0.05) {
+        meets_top = true;
+        solid = lo <= st.c + 1e-6;
+      }
+      // Material above within reach of the band's fade would be sliced by bent layers.
+      if (lo > top_z[kk] + 0.05 && lo < top_z[kk] + 4.5 * (relief + p.layer_height) + 2.0)
+        above = true;
+    }
+    if (!meets_top) continue;  // a sample at the patch's rim, just off the part
+    if (!solid) {
+      out.failure = fmt2("part is not solid from z = %.2f up to the patch at x = %.2f", st.c, x);
+      return out;
+    }
+    if (above) {
+      out.failure =
+          fmt2("other material of the part lies above the patch at x = %.2f, y = %.2f", x, y);
+      return out;
+    }
+  }
+
+  // Starting stack and optimisation of the intermediate control heights.
+  const int nc = top.surface.n_u * top.surface.n_v;
+  Eigen::MatrixXd Z(N + 1, nc);
+  for (int i = 0; i <= N; ++i) {
+    const double a = std::pow(static_cast<double>(i) / N, initial_power);
+    for (int j = 0; j < nc; ++j) Z(i, j) = (1 - a) * top.surface.points[j].z() + a * st.c;
+  }
+  // A quadratic penalty always tolerates a small overshoot, so it aims 5 µm inside the
+  // limits; the figures below are then checked against the limits themselves.
+  const double inset = 0.005;
+  const CostTerms terms{p.layer_height,
+                        p.min_layer_height + inset,
+                        p.max_layer_height - inset,
+                        p.continuity_weight,
+                        1e5,
+                        std::tan(p.max_angle_deg * kDeg) - 0.01};
+  st.cost_before = printability_cost(coarse, Z, terms, nullptr);
+  Eigen::MatrixXd best = Z;
+  if (N >= 2 && p.max_iterations > 0) {
+    std::vector<double> x(static_cast<std::size_t>(N - 1) * nc);
+    for (int i = 1; i < N; ++i)
+      for (int j = 0; j < nc; ++j) x[(i - 1) * nc + j] = Z(i, j);
+    ceres::GradientProblem problem(new StackObjective(coarse, Z, terms));
+    ceres::GradientProblemSolver::Options o;
+    o.line_search_direction_type =
+        p.optimizer == StackOptimizer::lbfgs ? ceres::LBFGS : ceres::STEEPEST_DESCENT;
+    o.max_num_iterations = p.max_iterations;
+    o.function_tolerance = 1e-7;
+    o.logging_type = ceres::SILENT;
+    ceres::GradientProblemSolver::Summary sum;
+    ceres::Solve(o, problem, x.data(), &sum);
+    st.iterations = static_cast<int>(sum.iterations.size()) - 1;
+    st.optimizer_message = sum.message;
+    for (int i = 1; i < N; ++i)
+      for (int j = 0; j < nc; ++j) best(i, j) = x[(i - 1) * nc + j];
+  }
+  st.cost_after = printability_cost(coarse, best, terms, nullptr);
+  Figures f = measure(grid, best, p);
+  const auto ok = [&](const Figures& g) {
+    return g.t_min >= p.min_layer_height - 1e-6 && g.t_max <= p.max_layer_height + 1e-6 &&
+           g.slope <= p.max_angle_deg + 0.5;
+  };
+  if (!ok(f) || !(st.cost_after <= st.cost_before)) {
+    // The optimiser traded a limit for cost (or did not get there): keep the paper's even
+    // interpolation, which meets the limits by the choice of c and N.
+    Eigen::MatrixXd even(N + 1, nc);
+    for (int i = 0; i <= N; ++i)
+      for (int j = 0; j < nc; ++j)
+        even(i, j) = (1 - static_cast<double>(i) / N) * top.surface.points[j].z() +
+                     static_cast<double>(i) / N * st.c;
+    const Figures fe = measure(grid, even, p);
+    if (ok(fe)) {
+      best = even, f = fe;
+      st.cost_after = printability_cost(coarse, even, terms, nullptr);
+      st.optimizer_message += " (result broke a limit; kept the even interpolation)";
+    }
+  }
+  st.thickness_min = f.t_min;
+  st.thickness_max = f.t_max;
+  st.max_slope_deg = f.slope;
+  st.max_block_rise = f.rise;
+  if (f.t_min < p.min_layer_height - 1e-6 || f.t_max > p.max_layer_height + 1e-6) {
+    out.failure = fmt2("layer thickness %.3f to %.3f mm leaves the limits", f.t_min, f.t_max);
+    return out;
+  }
+  if (f.slope > p.max_angle_deg + 0.5) {
+    out.failure = fmt2("layer slope %.1f deg exceeds max_angle %.1f deg", f.slope, p.max_angle_deg);
+    return out;
+  }
+  if (f.rise > p.block_clearance) {
+    out.failure = fmt2("a layer rises %.2f mm within the heater block radius, clearance is %.2f mm",
+                       f.rise, p.block_clearance);
+    return out;
+  }
+  for (int i = 0; i <= N; ++i) {
+    HeightField s = top;
+    for (int j = 0; j < nc; ++j) s.surface.points[j].z() = best(i, j);
+    st.surfaces.push_back(std::move(s));
+  }
+  Band& b = out.band;
+  b.top = top;
+  b.Z = best;
+  b.c = st.c;
+  b.N = N;
+  b.T_bottom = st.T_bottom;
+  // How far the curved layers sit from the planar ones decides how gently they blend.
+  double dev = 0;
+  for (int kk = 0; kk < n; ++kk)
+    dev = std::max(dev, std::abs(top_z[kk] - (st.c + N * p.layer_height)));
+  b.fade = std::max(1.0, 4.5 * dev);
+  const double blend = std::max(2.0, 1.3 * 1.5 * dev / std::tan(p.max_angle_deg * kDeg));
+  const PatchRaster wide =
+      rasterize_patch(mesh, patch, std::max(0.25, p.grid_step / 2), blend + 2.0);
+  set_blend(b, wide, blend);
+  return out;
+}
+
+}  // namespace nonplanar::layers

@@ -1,0 +1,215 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "core/column_caster.hpp"
+#include "core/mesh_topology.hpp"
+#include "layers/stack_builder.hpp"
+#include "nonplanar/deform.hpp"
+#include "nonplanar/layers.hpp"
+#include "support/geometry.hpp"
+#include "support/solids.hpp"
+
+namespace nonplanar {
+namespace {
+
+struct Planned {
+  TriangleMesh mesh;
+  Analysis analysis;
+  std::vector<SurfaceFit> fits;
+  std::vector<int> ids;
+  LayerPlan plan;
+};
+
+Planned plan_for(TriangleMesh mesh, const AnalysisParams& ap = {}, const LayerParams& lp = {}) {
+  Planned p;
+  p.mesh = std::move(mesh);
+  p.analysis = *analyze(p.mesh, ap, {});
+  for (std::size_t i = 0; i < p.analysis.patches.size(); ++i)
+    if (p.analysis.patches[i].needs_nonplanar()) {
+      auto f = fit_patch(p.mesh, p.analysis.patches[i], {}, {});
+      EXPECT_TRUE(f);
+      p.fits.push_back(*f);
+      p.ids.push_back(static_cast<int>(i));
+    }
+  auto plan = plan_layers(p.mesh, p.analysis, p.fits, p.ids, lp, {});
+  EXPECT_TRUE(plan) << plan.error().message;
+  p.plan = *plan;
+  return p;
+}
+
+TriangleMesh saddle() {
+  return test::height_field_solid([](double x, double y) { return 10 + (x * x - y * y) / 60.0; },
+                                  -12, 12, -12, 12, 96, 96);
+}
+TriangleMesh sine_roof() {
+  return test::height_field_solid(
+      [](double x, double) { return 8 + 1.0 * std::sin(2 * M_PI * x / 25); }, 0, 50, 0, 30, 150,
+      60);
+}
+TriangleMesh towers() {
+  TriangleMesh m = test::box({0, 0, 0}, {80, 40, 3});
+  auto dome = [](double cx, double cy) {
+    return [=](double x, double y) {
+      return 18 + 2.0 * std::cos(0.1 * (x - cx)) * std::cos(0.1 * (y - cy));
+    };
+  };
+  test::append(m, test::height_field_solid(dome(20, 20), 10, 30, 10, 30, 40, 40, 3));
+  test::append(m, test::height_field_solid(dome(60, 20), 50, 70, 10, 30, 40, 40, 3));
+  return m;
+}
+
+// The limits of the issue, checked through the field on a 0.5 mm grid over each patch.
+void expect_printable(const Planned& p, std::size_t stacks) {
+  const LayerParams lp;
+  ASSERT_EQ(p.plan.stacks.size(), stacks);
+  ASSERT_TRUE(p.plan.fallbacks.empty()) << p.plan.fallbacks[0].reason;
+  const LayerField& F = *p.plan.field;
+  const ColumnCaster cols(p.mesh);
+  const double tan_max = std::tan(lp.max_angle_deg * M_PI / 180.0);
+  for (std::size_t s = 0; s < p.plan.stacks.size(); ++s) {
+    const LayerStack& st = p.plan.stacks[s];
+    const HeightField& top = p.fits[s].surface;
+    const double T_top = st.T_bottom + st.layers;
+    double worst_slope = 0, t_lo = 1e9, t_hi = 0, top_err = 0;
+    for (double x = st.xy_min.x() + 0.25; x < st.xy_max.x(); x += 0.5)
+      for (double y = st.xy_min.y() + 0.25; y < st.xy_max.y(); y += 0.5) {
+        // Only columns under the patch: their highest crossing is the fitted top.
+        const auto z = cols.crossings(x, y);
+        if (z.empty() || std::abs(z.back() - top.height(x, y)) > 0.05) continue;
+        top_err = std::max(top_err, std::abs(F.z_at(x, y, T_top) - top.height(x, y)));
+        for (int k = static_cast<int>(st.T_bottom); k < T_top - 0.5; ++k) {
+          const double z0 = F.z_at(x, y, k), z1 = F.z_at(x, y, k + 1);
+          t_lo = std::min(t_lo, z1 - z0);
+          t_hi = std::max(t_hi, z1 - z0);
+          const double gx = (F.z_at(x + 0.05, y, k + 1) - z1) / 0.05;
+          const double gy = (F.z_at(x, y + 0.05, k + 1) - z1) / 0.05;
+          worst_slope = std::max(worst_slope, std::hypot(gx, gy));
+        }
+      }
+    EXPECT_GE(t_lo, lp.min_layer_height - 1e-6);
+    EXPECT_LE(t_hi, lp.max_layer_height + 1e-6);
+    EXPECT_LE(worst_slope, tan_max * 1.01);  // finite differences of a 0.05 mm step
+    EXPECT_LE(top_err, 0.001);               // the last layer is the fitted surface
+    EXPECT_LE(st.max_block_rise, lp.block_clearance);
+    EXPECT_GT(st.layers, 3);
+  }
+}
+
+void expect_monotone_and_invertible(const Planned& p) {
+  const LayerField& F = *p.plan.field;
+  const BoundingBox b = bounding_box(p.mesh);
+  for (double x = b.min.x() - 3; x <= b.max.x() + 3; x += 1.3)
+    for (double y = b.min.y() - 3; y <= b.max.y() + 3; y += 1.7) {
+      double prev = F.T(x, y, -0.5);
+      for (double z = -0.49; z < b.max.z() + 3; z += 0.01) {
+        const double t = F.T(x, y, z);
+        ASSERT_GT(t, prev) << x << " " << y << " " << z;
+        prev = t;
+      }
+      for (double z = 0.05; z < b.max.z() + 2; z += 0.37)
+        ASSERT_NEAR(F.z_at(x, y, F.T(x, y, z)), z, 1e-6);
+    }
+}
+
+TEST(Layers, SaddleStackMeetsTheLimits) {
+  const Planned p = plan_for(saddle());
+  expect_printable(p, 1);
+  expect_monotone_and_invertible(p);
+}
+
+TEST(Layers, SineRoofStackMeetsTheLimits) {
+  const Planned p = plan_for(sine_roof());
+  expect_printable(p, 1);
+  expect_monotone_and_invertible(p);
+}
+
+TEST(Layers, TwoTowersGetTwoStacksInOneField) {
+  const Planned p = plan_for(towers());
+  expect_printable(p, 2);
+  expect_monotone_and_invertible(p);
+  // Between the towers the layers are planar: ζ(T(z)) = z.
+  const LayerField& F = *p.plan.field;
+  for (double z = 0.1; z < 22; z += 0.3) EXPECT_NEAR(F.zeta(F.T(40, 20, z)), z, 1e-12);
+}
+
+TEST(Layers, OptimiserLowersTheCostOfAPoorStart) {
+  const TriangleMesh m = sine_roof();
+  const Analysis a = *analyze(m, {}, {});
+  const auto fit = fit_patch(m, a.patches[0], {}, {});
+  ASSERT_TRUE(fit);
+  const ColumnCaster cols(m);
+  LayerParams lp;
+  lp.max_iterations = 1000;
+  const layers::PlanarLayers planar{lp.first_layer_height, lp.layer_height};
+  // a_i = (i/N)³ bunches the layers at the top: thin there, thick below.
+  const auto r = layers::build_stack(m, a.patches[0], 0, fit->surface, cols, lp, planar, 3.0);
+  ASSERT_TRUE(r.failure.empty()) << r.failure;
+  EXPECT_LT(r.stack.cost_after, 0.5 * r.stack.cost_before);
+  EXPECT_GT(r.stack.iterations, 0);
+  // The optimiser's own result met the limits (no fall-back to the even stack).
+  EXPECT_EQ(r.stack.optimizer_message.find("kept"), std::string::npos) << r.stack.optimizer_message;
+  EXPECT_GE(r.stack.thickness_min, lp.min_layer_height - 1e-6);
+  EXPECT_LE(r.stack.thickness_max, lp.max_layer_height + 1e-6);
+  // Steepest descent (the paper's eq. 2) also lowers it.
+  lp.optimizer = StackOptimizer::gradient_descent;
+  const auto gd = layers::build_stack(m, a.patches[0], 0, fit->surface, cols, lp, planar, 3.0);
+  ASSERT_TRUE(gd.failure.empty()) << gd.failure;
+  EXPECT_LT(gd.stack.cost_after, 0.9 * gd.stack.cost_before);
+  // The even interpolation is a stationary point of eq. (1): nothing to improve there.
+  const auto even = layers::build_stack(m, a.patches[0], 0, fit->surface, cols, lp, planar, 1.0);
+  EXPECT_NEAR(even.stack.cost_after, even.stack.cost_before, 1e-9 * even.stack.cost_before);
+  EXPECT_LE(r.stack.cost_after, even.stack.cost_before * 1.01);
+}
+
+TEST(Layers, SteepConeFallsBackToPlanarWithTheReason) {
+  AnalysisParams wide;
+  wide.max_angle_deg = 60;  // paint the 45° cone, so the printer limit must refuse it
+  const Planned p =
+      plan_for(test::height_field_solid([](double x, double y) { return 20 - std::hypot(x, y); },
+                                        -10, 10, -10, 10, 40, 40),
+               wide);
+  ASSERT_EQ(p.plan.stacks.size(), 0u);
+  ASSERT_EQ(p.plan.fallbacks.size(), 1u);
+  EXPECT_NE(p.plan.fallbacks[0].reason.find("exceeds max_angle 30.0"), std::string::npos)
+      << p.plan.fallbacks[0].reason;
+  // The field is planar everywhere then.
+  EXPECT_NEAR(p.plan.field->zeta(p.plan.field->T(3, 4, 12.345)), 12.345, 1e-12);
+}
+
+TEST(Layers, BadParametersNameTheKey) {
+  LayerParams lp;
+  lp.min_layer_height = 0.35;
+  auto r = plan_layers(saddle(), {}, {}, {}, lp, {});
+  ASSERT_FALSE(r);
+  EXPECT_EQ(r.error().message.rfind("min_layer_height:", 0), 0u);
+}
+
+TEST(Deform, NormalisedPlaneKCutsTheOriginalAlongCurvedLayerK) {
+  const Planned p = plan_for(saddle());
+  ASSERT_EQ(p.plan.stacks.size(), 1u);
+  const LayerField& F = *p.plan.field;
+  auto n = normalize_mesh(p.mesh, F, {}, {});
+  ASSERT_TRUE(n) << n.error().message;
+  const MeshTopology topo = build_topology(n->mesh);
+  EXPECT_EQ(topo.open_edges, 0u);
+  EXPECT_EQ(topo.non_manifold_edges, 0u);
+  EXPECT_EQ(topo.inconsistent_edges, 0u);
+  EXPECT_GT(signed_volume(n->mesh), 0.0);
+  EXPECT_GT(n->edges_split, 0u);
+  const LayerStack& st = p.plan.stacks[0];
+  for (int k : {static_cast<int>(st.T_bottom) + st.layers / 2,
+                static_cast<int>(st.T_bottom) + st.layers - 1}) {
+    const auto pts = test::plane_cut_points(n->mesh, F.zeta(k));
+    ASSERT_GT(pts.size(), 50u);
+    double worst = 0;
+    for (std::size_t i = 0; i < pts.size(); i += 7) {
+      const Vec3 back(pts[i].x(), pts[i].y(), F.z_at(pts[i].x(), pts[i].y(), k));
+      worst = std::max(worst, test::distance_to_mesh(p.mesh, back));
+    }
+    EXPECT_LE(worst, 0.01) << "layer " << k;
+  }
+}
+
+}  // namespace
+}  // namespace nonplanar
