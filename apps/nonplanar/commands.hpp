@@ -10,5 +10,7 @@ namespace nonplanar::cli {
 void register_analyze(CLI::App& app, std::function<int()>* run);
 /// Adds "fit".
 void register_fit(CLI::App& app, std::function<int()>* run);
+/// Adds "layers".
+void register_layers(CLI::App& app, std::function<int()>* run);
 
 }  // namespace nonplanar::cli

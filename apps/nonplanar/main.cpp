@@ -18,6 +18,7 @@ int main(int argc, char** argv) {
   std::function<int()> run;
   register_analyze(app, &run);
   register_fit(app, &run);
+  register_layers(app, &run);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

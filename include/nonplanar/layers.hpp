@@ -8,6 +8,7 @@
 // layers are planar), so the normalised mesh is (x, y, ζ(T(x, y, z))).
 #pragma once
 
+#include <filesystem>
 #include <memory>
 #include <string>
 #include <vector>
@@ -92,7 +93,15 @@ class LayerField {
   virtual double t_of_zeta(double zeta) const = 0;
   /// Local layer thickness at (x, y, z): 1 / ∂T/∂z, mm.
   virtual double thickness(double x, double y, double z) const = 0;
+  /// True where no band reaches (x, y): there T is planar at every z.
+  virtual bool planar_at(double x, double y) const = 0;
 };
+
+/// A vertical cross-section of the part as SVG: the part's outline, every layer boundary
+/// inside the material (curved ones highlighted), axes in mm. axis 'x' cuts the plane
+/// x = value (the picture's horizontal axis is then y); 'y' cuts y = value. Atomic.
+Expected<bool> write_section_svg(const std::filesystem::path& file, const TriangleMesh& mesh,
+                                 const LayerPlan& plan, char axis, double value);
 
 /// A planar-only field (first layer h₁, then h).
 std::shared_ptr<const LayerField> planar_field(const LayerParams& params);

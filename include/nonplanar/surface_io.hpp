@@ -16,6 +16,9 @@ struct SurfaceRecord {
   int patch = -1;
   HeightField surface;
   double rms_error = 0, max_error = 0;
+  int layer = -1;              ///< for curved layers: 0 = top of the stack; −1: a fit
+  bool has_footprint = false;  ///< the patch's XY box, written as "footprint"
+  Vec2 footprint_min{0, 0}, footprint_max{0, 0};
 };
 
 /// Writes {"format": "nonplanar-surfaces", "version": 1, "units": "mm", "surfaces": [...]}.

@@ -38,14 +38,15 @@ std::vector<double> ColumnCaster::crossings(double x, double y) const {
   for (int f : bins_[static_cast<std::size_t>(i) * ny_ + j]) {
     const auto& t = mesh_.faces[f];
     const Vec3 &a = mesh_.vertices[t[0]], &b = mesh_.vertices[t[1]], &c = mesh_.vertices[t[2]];
-    // Barycentric coordinates in XY; a half-open rule on edges so a line through a shared
-    // edge or vertex is counted once.
+    // Barycentric coordinates in XY, with a little slack so a line through a shared edge
+    // or vertex is claimed by every face there (rounding must not drop it); the copies
+    // have the same height and are merged below.
     const double d = (b.x() - a.x()) * (c.y() - a.y()) - (c.x() - a.x()) * (b.y() - a.y());
     if (d == 0.0) continue;  // vertical triangle: the line grazes it
     const double l1 = ((x - a.x()) * (c.y() - a.y()) - (c.x() - a.x()) * (y - a.y())) / d;
     const double l2 = ((b.x() - a.x()) * (y - a.y()) - (x - a.x()) * (b.y() - a.y())) / d;
     const double l0 = 1.0 - l1 - l2;
-    auto in = [](double l) { return l > 0.0 || (l == 0.0); };
+    auto in = [](double l) { return l >= -1e-12; };
     if (!(in(l0) && in(l1) && in(l2))) continue;
     z.push_back(l0 * a.z() + l1 * b.z() + l2 * c.z());
   }

@@ -47,6 +47,11 @@ class BandedField final : public LayerField {
   double zeta(double t) const override { return pl_.zeta(t); }
   double t_of_zeta(double z) const override { return pl_.t_of_zeta(z); }
   double thickness(double x, double y, double z) const override;
+  bool planar_at(double x, double y) const override {
+    for (const Band& b : bands_)
+      if (b.beta(x, y) > 0) return false;
+    return true;
+  }
   const std::vector<Band>& bands() const { return bands_; }
 
  private:

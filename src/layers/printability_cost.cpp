@@ -7,6 +7,27 @@
 
 namespace nonplanar::layers {
 
+void StackGrid::pair_within(double radius, double spacing) {
+  block_pairs.clear();
+  const int sx = std::max(1, static_cast<int>(std::lround(spacing / step_x)));
+  const int sy = std::max(1, static_cast<int>(std::lround(spacing / step_y)));
+  const int rx = static_cast<int>(radius / (sx * step_x)),
+            ry = static_cast<int>(radius / (sy * step_y));
+  for (int a = 0; a < nx; a += sx)
+    for (int b = 0; b < ny; b += sy) {
+      const int k = a * ny + b;
+      if (!on_patch[k]) continue;
+      for (int di = -rx; di <= rx; ++di)
+        for (int dj = -ry; dj <= ry; ++dj) {
+          const int a2 = a + di * sx, b2 = b + dj * sy;
+          if ((di == 0 && dj == 0) || a2 < 0 || b2 < 0 || a2 >= nx || b2 >= ny) continue;
+          if (std::hypot(di * sx * step_x, dj * sy * step_y) > radius) continue;
+          const int l = a2 * ny + b2;
+          if (on_patch[l]) block_pairs.emplace_back(k, l);
+        }
+    }
+}
+
 int StackGrid::control(int k, int a) const {
   const int i0 = first[k] / n_v, j0 = first[k] % n_v;
   return (i0 + a / (q + 1)) * n_v + (j0 + a % (q + 1));
@@ -68,6 +89,9 @@ double printability_cost(const StackGrid& g, const Eigen::MatrixXd& Z, const Cos
   if (grad) grad->setZero(L - 2 > 0 ? L - 2 : 0, Z.cols());
   double cost = 0;
   std::vector<double> S(L), Sx(L), Sy(L), dS(L), dSx(L), dSy(L);
+  // Heights of every layer at every sample, kept for the heater-block pairs below.
+  const bool pairs = c.clearance < 1e299 && !g.block_pairs.empty() && L > 2;
+  std::vector<double> all(pairs ? static_cast<std::size_t>(L) * n : 0);
   for (int k = 0; k < n; ++k) {
     const double* R = &g.R[static_cast<std::size_t>(k) * g.m];
     const double* Rx = &g.Rx[static_cast<std::size_t>(k) * g.m];
@@ -79,6 +103,7 @@ double printability_cost(const StackGrid& g, const Eigen::MatrixXd& Z, const Cos
         s += R[a] * z, sx += Rx[a] * z, sy += Ry[a] * z;
       }
       S[i] = s, Sx[i] = sx, Sy[i] = sy;
+      if (pairs) all[static_cast<std::size_t>(i) * n + k] = s;
       dS[i] = dSx[i] = dSy[i] = 0;
     }
     const double ak = g.area[k];
@@ -114,6 +139,24 @@ double printability_cost(const StackGrid& g, const Eigen::MatrixXd& Z, const Cos
       for (int a = 0; a < g.m; ++a)
         (*grad)(i - 1, g.control(k, a)) += dS[i] * R[a] + dSx[i] * Rx[a] + dSy[i] * Ry[a];
     }
+  }
+  // Heater block: a layer may not rise more than H within the block radius. Only the
+  // intermediate layers are free; the top is the part and the bottom is flat.
+  if (pairs) {
+    for (int i = 1; i + 1 < L; ++i)
+      for (const auto& [k, l] : g.block_pairs) {
+        const double* Si = &all[static_cast<std::size_t>(i) * n];
+        const double over = Si[l] - Si[k] - c.clearance;
+        if (over <= 0) continue;
+        const double w = g.area[k];
+        cost += w * c.mu * over * over;
+        if (!grad) continue;
+        const double d = 2 * w * c.mu * over;
+        for (int a = 0; a < g.m; ++a) {
+          (*grad)(i - 1, g.control(l, a)) += d * g.R[static_cast<std::size_t>(l) * g.m + a];
+          (*grad)(i - 1, g.control(k, a)) -= d * g.R[static_cast<std::size_t>(k) * g.m + a];
+        }
+      }
   }
   return cost;
 }

@@ -8,7 +8,9 @@
 //   C = Σ_k a_k [ m_k Σ_i (t_ik − h)²                       (eq. 1, squared: smooth)
 //               + m_k λ Σ_i |∇S_i − ∇S_{i+1}|²            (continuity)
 //               + μ Σ_i (max(0, h_min − t)² + max(0, t − h_max)²)
-//               + μ Σ_i max(0, |∇S_i| − g)² ]            (slope: g = min(tan α, H/R))
+//               + μ Σ_i max(0, |∇S_i| − g)² ]            (slope: g = tan α)
+//     + μ Σ_i Σ_(k,l) max(0, S_i(l) − S_i(k) − H)²          (heater block: pairs of samples
+//                                                              on the patch within radius R)
 // with m_k = 1 on the patch, 0 in the margin around it (limits hold there too).
 #pragma once
 
@@ -29,12 +31,17 @@ struct StackGrid {
   int n_u = 0, n_v = 0, q = 0;
   int nx = 0, ny = 0;  ///< sample k = i·ny + j at (i + ½, j + ½)·step
   double step_x = 0, step_y = 0;
+  std::vector<std::pair<int, int>> block_pairs;  ///< (k, l): l within the block radius of k
+
+  /// Fills block_pairs on a subgrid of about `spacing` mm over the patch's samples.
+  void pair_within(double radius, double spacing);
 
   int control(int k, int a) const;  ///< control index of the a-th basis function of sample k
 };
 
 struct CostTerms {
   double h, h_min, h_max, lambda, mu, g;
+  double clearance = 1e300;  ///< H: largest rise allowed within the block radius
 };
 
 /// Cost of the stack with control heights Z (layers × controls, row-major); if grad is

@@ -156,8 +156,12 @@ StackResult build_stack(const TriangleMesh& mesh, const Patch& patch, int patch_
   const double c_max = zmin - d_req;
   const double k = std::floor((c_max - p.first_layer_height) / p.layer_height + 1e-9);
   if (k < 0) {
-    out.failure = fmt2("needs %.2f mm of part below the patch's lowest point, has %.2f mm",
-                       d_req + p.first_layer_height, zmin);
+    // One plane under the whole patch must sit relief / (h_max/h_min − 1) below its lowest
+    // point and above the first layer.
+    out.failure = fmt2(
+        "relief %.2f mm needs the stack's plane %.2f mm below the surface's lowest "
+        "point, which is below the first layer",
+        relief, d_req);
     return out;
   }
   st.c = p.first_layer_height + k * p.layer_height;
@@ -216,7 +220,9 @@ StackResult build_stack(const TriangleMesh& mesh, const Patch& patch, int patch_
                         p.max_layer_height - inset,
                         p.continuity_weight,
                         1e5,
-                        std::tan(p.max_angle_deg * kDeg) - 0.01};
+                        std::tan(p.max_angle_deg * kDeg) - 0.01,
+                        p.block_clearance - 0.05};
+  coarse.pair_within(p.block_radius, 2.0);
   st.cost_before = printability_cost(coarse, Z, terms, nullptr);
   Eigen::MatrixXd best = Z;
   if (N >= 2 && p.max_iterations > 0) {

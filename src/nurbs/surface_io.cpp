@@ -16,20 +16,25 @@ ordered_json to_json(const SurfaceRecord& r) {
   const NurbsSurface& s = r.surface.surface;
   ordered_json pts = ordered_json::array();
   for (const Vec3& p : s.points) pts.push_back({p.x(), p.y(), p.z()});
-  return {{"patch", r.patch},
-          {"degree_u", s.p},
-          {"degree_v", s.q},
-          {"count_u", s.n_u},
-          {"count_v", s.n_v},
-          {"knots_u", s.U},
-          {"knots_v", s.V},
-          {"control_points", std::move(pts)},
-          {"weights", s.weights},
-          {"uv_map",
-           {{"origin", {r.surface.origin.x(), r.surface.origin.y()}},
-            {"extent", {r.surface.extent.x(), r.surface.extent.y()}}}},
-          {"rms_error", r.rms_error},
-          {"max_error", r.max_error}};
+  ordered_json j = {{"patch", r.patch},
+                    {"degree_u", s.p},
+                    {"degree_v", s.q},
+                    {"count_u", s.n_u},
+                    {"count_v", s.n_v},
+                    {"knots_u", s.U},
+                    {"knots_v", s.V},
+                    {"control_points", std::move(pts)},
+                    {"weights", s.weights},
+                    {"uv_map",
+                     {{"origin", {r.surface.origin.x(), r.surface.origin.y()}},
+                      {"extent", {r.surface.extent.x(), r.surface.extent.y()}}}},
+                    {"rms_error", r.rms_error},
+                    {"max_error", r.max_error}};
+  if (r.layer >= 0) j["layer"] = r.layer;
+  if (r.has_footprint)
+    j["footprint"] = {{"xy_min", {r.footprint_min.x(), r.footprint_min.y()}},
+                      {"xy_max", {r.footprint_max.x(), r.footprint_max.y()}}};
+  return j;
 }
 
 SurfaceRecord from_json(const nlohmann::json& j) {
@@ -52,6 +57,13 @@ SurfaceRecord from_json(const nlohmann::json& j) {
   r.surface.extent = {m.at("extent").at(0).get<double>(), m.at("extent").at(1).get<double>()};
   r.rms_error = j.value("rms_error", 0.0);
   r.max_error = j.value("max_error", 0.0);
+  r.layer = j.value("layer", -1);
+  if (j.contains("footprint")) {
+    const auto& f = j.at("footprint");
+    r.has_footprint = true;
+    r.footprint_min = {f.at("xy_min").at(0).get<double>(), f.at("xy_min").at(1).get<double>()};
+    r.footprint_max = {f.at("xy_max").at(0).get<double>(), f.at("xy_max").at(1).get<double>()};
+  }
   return r;
 }
 

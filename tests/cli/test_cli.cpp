@@ -101,6 +101,38 @@ TEST(Cli, FitReportsErrorsAndExportsSurfaces) {
   EXPECT_EQ(run("fit --solver bogus " + (dir / "w.stl").string()).code, 2);
 }
 
+TEST(Cli, LayersReportsStacksAndWritesTheirFiles) {
+  const auto dir = test::temp_dir("cli_layers");
+  ASSERT_TRUE(write_stl(
+      dir / "roof.stl",
+      test::height_field_solid([](double x, double) { return 8 + std::sin(2 * M_PI * x / 25); }, 0,
+                               50, 0, 30, 150, 60)));
+  const CliResult r =
+      run("layers --json " + (dir / "roof.stl").string() + " --export-layers " +
+          (dir / "l.json").string() + " --export-normalized " + (dir / "n.stl").string() +
+          " --section " + (dir / "s.svg").string() + " --at y=110");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  ASSERT_EQ(j["stacks"].size(), 1u);
+  const auto& st = j["stacks"][0];
+  EXPECT_GE(st["thickness_min"].get<double>(), 0.1 - 1e-9);
+  EXPECT_LE(st["thickness_max"].get<double>(), 0.3 + 1e-9);
+  EXPECT_LE(st["max_slope"].get<double>(), 30.0);
+  EXPECT_GT(st["layers"].get<int>(), 3);
+  const auto layers = nlohmann::json::parse(test::read_bytes(dir / "l.json"));
+  EXPECT_EQ(layers["surfaces"].size(), st["layers"].get<std::size_t>() + 1);
+  EXPECT_EQ(layers["surfaces"][0]["layer"], 0);
+  EXPECT_TRUE(layers["surfaces"][0].contains("footprint"));
+  auto n = load_mesh(dir / "n.stl", test::unplaced(), {});
+  ASSERT_TRUE(n) << n.error().message;
+  EXPECT_TRUE(n->defects.closed());
+  const std::string svg = test::read_bytes(dir / "s.svg");
+  EXPECT_EQ(svg.rfind("<svg", 0), 0u);
+  EXPECT_NE(svg.find("#e8700a"), std::string::npos);  // curved layers are drawn
+  EXPECT_EQ(run("layers --section x.svg --at z=3 " + (dir / "roof.stl").string()).code, 2);
+  EXPECT_EQ(run("layers --max-layer-height 0.05 " + (dir / "roof.stl").string()).code, 2);
+}
+
 TEST(Cli, HelpAndUsage) {
   const CliResult h = run("analyze --help");
   EXPECT_EQ(h.code, 0);

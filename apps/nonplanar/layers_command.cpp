@@ -1,0 +1,177 @@
+// `nonplanar layers`: analyse, fit, and build the curved layer stacks and the layer field;
+// report the figures, export the layers, the normalised mesh and a cross-section picture.
+#include <cstdio>
+#include <map>
+#include <memory>
+#include <nlohmann/json.hpp>
+
+#include "cli_common.hpp"
+#include "commands.hpp"
+#include "nonplanar/deform.hpp"
+#include "nonplanar/layers.hpp"
+#include "nonplanar/surface_io.hpp"
+
+namespace nonplanar::cli {
+namespace {
+
+struct LayersOptions {
+  MeshOptions mesh;
+  AnalysisParams analysis;
+  FitParams fit;
+  LayerParams layers;
+  bool json = false;
+  std::string export_layers, export_normalized, section, at;
+};
+
+int run(LayersOptions o) {
+  // One printer angle and one minimum height serve facet selection and the stacks alike.
+  o.layers.max_angle_deg = o.analysis.max_angle_deg;
+  o.layers.min_layer_height = o.analysis.min_layer_height;
+  char axis = 0;
+  double at = 0;
+  if (!o.section.empty()) {
+    if (o.at.size() < 3 || (o.at[0] != 'x' && o.at[0] != 'y') || o.at[1] != '=')
+      return report_error({Status::invalid_argument, "--at: expected x=VALUE or y=VALUE"});
+    try {
+      at = std::stod(o.at.substr(2));
+    } catch (...) {
+      return report_error(
+          {Status::invalid_argument, "--at: '" + o.at.substr(2) + "' is not a number"});
+    }
+    axis = o.at[0];
+  }
+  Context ctx = make_context(o.mesh.quiet || o.json);
+  auto loaded = load_mesh(o.mesh.model, o.mesh.load, ctx);
+  if (!loaded) return finish_progress(), report_error(loaded.error());
+  auto analysis = analyze(loaded->mesh, o.analysis, ctx);
+  if (!analysis) return finish_progress(), report_error(analysis.error());
+  std::vector<SurfaceFit> fits;
+  std::vector<int> ids;
+  for (std::size_t i = 0; i < analysis->patches.size(); ++i) {
+    if (!analysis->patches[i].needs_nonplanar()) continue;
+    auto fit = fit_patch(loaded->mesh, analysis->patches[i], o.fit, ctx);
+    if (!fit) return finish_progress(), report_error(fit.error());
+    fits.push_back(std::move(*fit));
+    ids.push_back(static_cast<int>(i));
+  }
+  auto plan = plan_layers(loaded->mesh, *analysis, fits, ids, o.layers, ctx);
+  if (!plan) return finish_progress(), report_error(plan.error());
+  std::size_t split = 0;
+  if (!o.export_normalized.empty()) {
+    auto n = normalize_mesh(loaded->mesh, *plan->field, {}, ctx);
+    if (!n) return finish_progress(), report_error(n.error());
+    split = n->edges_split;
+    if (auto w = write_stl(o.export_normalized, n->mesh); !w)
+      return finish_progress(), report_error(w.error());
+  }
+  finish_progress();
+  report_warnings(o.mesh.model, *loaded, o.mesh.quiet);
+  if (!o.export_layers.empty()) {
+    std::vector<SurfaceRecord> recs;
+    for (const LayerStack& st : plan->stacks)
+      for (std::size_t i = 0; i < st.surfaces.size(); ++i) {
+        SurfaceRecord r;
+        r.patch = st.patch;
+        r.layer = static_cast<int>(i);
+        r.surface = st.surfaces[i];
+        r.has_footprint = true;
+        r.footprint_min = st.xy_min;
+        r.footprint_max = st.xy_max;
+        recs.push_back(std::move(r));
+      }
+    if (auto w = write_surfaces_json(o.export_layers, recs); !w) return report_error(w.error());
+  }
+  if (axis)
+    if (auto w = write_section_svg(o.section, loaded->mesh, *plan, axis, at); !w)
+      return report_error(w.error());
+
+  if (o.json) {
+    nlohmann::ordered_json j;
+    j["file"] = o.mesh.model;
+    j["params"] = {{"layer_height", o.layers.layer_height},
+                   {"first_layer_height", o.layers.first_layer_height},
+                   {"min_layer_height", o.layers.min_layer_height},
+                   {"max_layer_height", o.layers.max_layer_height},
+                   {"max_angle", o.layers.max_angle_deg},
+                   {"block_radius", o.layers.block_radius},
+                   {"block_clearance", o.layers.block_clearance}};
+    nlohmann::ordered_json stacks = nlohmann::ordered_json::array();
+    for (const LayerStack& st : plan->stacks)
+      stacks.push_back({{"patch", st.patch},
+                        {"layers", st.layers},
+                        {"c", st.c},
+                        {"thickness_min", st.thickness_min},
+                        {"thickness_max", st.thickness_max},
+                        {"max_slope", st.max_slope_deg},
+                        {"max_block_rise", st.max_block_rise},
+                        {"cost_before", st.cost_before},
+                        {"cost_after", st.cost_after},
+                        {"iterations", st.iterations},
+                        {"optimizer", st.optimizer_message}});
+    j["stacks"] = std::move(stacks);
+    nlohmann::ordered_json fb = nlohmann::ordered_json::array();
+    for (const auto& f : plan->fallbacks) fb.push_back({{"patch", f.patch}, {"reason", f.reason}});
+    j["planar_fallbacks"] = std::move(fb);
+    if (!o.export_normalized.empty()) j["normalized_edges_split"] = split;
+    std::printf("%s\n", j.dump(2).c_str());
+    return kExitOk;
+  }
+  std::printf("%s: %zu curved stack%s, %zu patch%s kept planar\n", o.mesh.model.c_str(),
+              plan->stacks.size(), plan->stacks.size() == 1 ? "" : "s", plan->fallbacks.size(),
+              plan->fallbacks.size() == 1 ? "" : "es");
+  for (const LayerStack& st : plan->stacks)
+    std::printf(
+        "  patch %d: %d layers from z = %.2f, thickness %.3f-%.3f mm, steepest %.1f deg, "
+        "block rise %.2f mm, cost %.4g -> %.4g (%d iterations)\n",
+        st.patch, st.layers, st.c, st.thickness_min, st.thickness_max, st.max_slope_deg,
+        st.max_block_rise, st.cost_before, st.cost_after, st.iterations);
+  for (const auto& f : plan->fallbacks)
+    std::printf("  patch %d planar: %s\n", f.patch, f.reason.c_str());
+  return kExitOk;
+}
+
+}  // namespace
+
+void register_layers(CLI::App& app, std::function<int()>* run_fn) {
+  auto opts = std::make_shared<LayersOptions>();
+  CLI::App* cmd = app.add_subcommand(
+      "layers",
+      "Build the curved layer stack under every patch (fitted top, plane below, optimised\n"
+      "intermediate layers) and the layer field of the whole part; patches whose stack\n"
+      "would break a printer limit stay planar, with the reason.");
+  opts->mesh.add_to(*cmd);
+  add_analysis_options(*cmd, opts->analysis);
+  LayerParams& l = opts->layers;
+  cmd->add_option("--layer-height", l.layer_height, "Layer height h (mm)")->capture_default_str();
+  cmd->add_option("--first-layer-height", l.first_layer_height, "First layer (mm)")
+      ->capture_default_str();
+  cmd->add_option("--max-layer-height", l.max_layer_height, "Thickest curved layer (mm)")
+      ->capture_default_str();
+  cmd->add_option("--block-radius", l.block_radius, "Heater block radius around the nozzle (mm)")
+      ->capture_default_str();
+  cmd->add_option("--block-clearance", l.block_clearance,
+                  "Heater block bottom above the nozzle tip (mm)")
+      ->capture_default_str();
+  cmd->add_option("--continuity-weight", l.continuity_weight, "lambda of the paper's eq. (1)")
+      ->capture_default_str();
+  const std::map<std::string, StackOptimizer> opt = {{"lbfgs", StackOptimizer::lbfgs},
+                                                     {"gd", StackOptimizer::gradient_descent}};
+  cmd->add_option("--optimizer", l.optimizer, "lbfgs or gd (gradient descent, eq. 2)")
+      ->transform(CLI::CheckedTransformer(opt, CLI::ignore_case))
+      ->default_str("lbfgs");
+  cmd->add_option("--iterations", l.max_iterations, "Optimiser iterations at most")
+      ->capture_default_str();
+  cmd->add_option("--fit-tolerance", opts->fit.tolerance, "Surface fit RMS target (mm)")
+      ->capture_default_str();
+  cmd->add_flag("--json", opts->json, "Print one JSON document");
+  cmd->add_option("--export-layers", opts->export_layers,
+                  "Write every curved layer surface as JSON (docs/surface-format.md)");
+  cmd->add_option("--export-normalized", opts->export_normalized,
+                  "Write the normalised mesh (curved layers made planar) as binary STL");
+  cmd->add_option("--section", opts->section, "Write a vertical cross-section as SVG");
+  cmd->add_option("--at", opts->at, "Where to cut for --section: x=VALUE or y=VALUE (mm)");
+  *run_fn = nullptr;
+  cmd->callback([opts, run_fn] { *run_fn = [opts] { return run(*opts); }; });
+}
+
+}  // namespace nonplanar::cli

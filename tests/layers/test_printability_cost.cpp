@@ -1,0 +1,59 @@
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "layers/patch_raster.hpp"
+#include "layers/printability_cost.hpp"
+#include "support/solids.hpp"
+
+namespace nonplanar {
+namespace {
+
+// The analytic gradient of the cost against central differences, on a stack whose terms
+// are all active: thickness outside the limits, steep layers, a tight heater clearance.
+TEST(PrintabilityCost, GradientMatchesFiniteDifferences) {
+  const TriangleMesh m = test::height_field_solid(
+      [](double x, double y) { return 6 + std::sin(x / 3) * std::cos(y / 4); }, 0, 12, 0, 10, 24,
+      20);
+  const Analysis a = *analyze(m, {}, {});
+  FitParams fp;
+  fp.max_control = 7;
+  const SurfaceFit fit = *fit_patch(m, a.patches[0], fp, {});
+  const layers::PatchRaster r = layers::rasterize_patch(m, a.patches[0], 0.25, 0.0);
+  layers::StackGrid g;
+  layers::build_stack_grid(g, fit.surface, 1.0, r.mask, r.origin, r.cell, r.nx, r.ny);
+  g.pair_within(3.0, 1.0);
+  ASSERT_FALSE(g.block_pairs.empty());
+  const int nc = fit.surface.surface.n_u * fit.surface.surface.n_v;
+  const int N = 5;
+  Eigen::MatrixXd Z(N + 1, nc);
+  std::mt19937 rng(4);
+  std::uniform_real_distribution<double> jitter(-0.6, 0.6);
+  for (int i = 0; i <= N; ++i)
+    for (int j = 0; j < nc; ++j)
+      Z(i, j) = (1.0 - i / 5.0) * fit.surface.surface.points[j].z() + i / 5.0 * 3.0 +
+                (i > 0 && i < N ? jitter(rng) : 0.0);
+  const layers::CostTerms terms{0.2, 0.1, 0.3, 0.05, 1e3, std::tan(10 * M_PI / 180), 0.3};
+  Eigen::MatrixXd grad;
+  const double c0 = layers::printability_cost(g, Z, terms, &grad);
+  ASSERT_GT(c0, 0);
+  ASSERT_EQ(grad.rows(), N - 1);
+  double worst = 0, scale = 0;
+  for (int i = 1; i < N; ++i)
+    for (int j = 0; j < nc; j += 3) {
+      const double e = 1e-6;
+      Eigen::MatrixXd Zp = Z, Zm = Z;
+      Zp(i, j) += e;
+      Zm(i, j) -= e;
+      const double fd = (layers::printability_cost(g, Zp, terms, nullptr) -
+                         layers::printability_cost(g, Zm, terms, nullptr)) /
+                        (2 * e);
+      worst = std::max(worst, std::abs(fd - grad(i - 1, j)));
+      scale = std::max(scale, std::abs(fd));
+    }
+  EXPECT_GT(scale, 1.0);
+  EXPECT_LT(worst, 1e-5 * scale);
+}
+
+}  // namespace
+}  // namespace nonplanar
