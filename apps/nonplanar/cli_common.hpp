@@ -6,6 +6,7 @@
 #include <string>
 
 #include "nonplanar/analysis.hpp"
+#include "nonplanar/config.hpp"
 #include "nonplanar/context.hpp"
 #include "nonplanar/io.hpp"
 #include "nonplanar/status.hpp"

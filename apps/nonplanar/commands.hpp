@@ -12,5 +12,7 @@ void register_analyze(CLI::App& app, std::function<int()>* run);
 void register_fit(CLI::App& app, std::function<int()>* run);
 /// Adds "layers".
 void register_layers(CLI::App& app, std::function<int()>* run);
+/// Adds "slice".
+void register_slice(CLI::App& app, std::function<int()>* run);
 
 }  // namespace nonplanar::cli

@@ -19,6 +19,7 @@ int main(int argc, char** argv) {
   register_analyze(app, &run);
   register_fit(app, &run);
   register_layers(app, &run);
+  register_slice(app, &run);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -1,0 +1,125 @@
+// `nonplanar slice`: mesh → layers → toolpaths → G-code. Today the planar engine
+// (--planar); the non-planar pipeline builds on it.
+#include <cstdio>
+#include <memory>
+
+#include "cli_common.hpp"
+#include "commands.hpp"
+#include "nonplanar/gcode.hpp"
+
+namespace nonplanar::cli {
+namespace {
+
+struct SliceOptions {
+  MeshOptions mesh;
+  std::string output, config;
+  bool planar = false;
+  // Overrides, applied by key after the profile, in this order.
+  std::vector<std::pair<std::string, std::string*>> named;
+  std::vector<std::string> sets;
+};
+
+int run(const SliceOptions& o) {
+  PrintConfig cfg;
+  if (!o.config.empty()) {
+    auto c = load_config(o.config);
+    if (!c) return report_error(c.error());
+    cfg = std::move(*c);
+  }
+  auto apply = [&](const std::string& key, const std::string& value) -> int {
+    auto r = set_config_value(cfg, key, value);
+    if (!r) return report_error({Status::invalid_argument, "--" + r.error().message});
+    if (!*r) return report_error({Status::invalid_argument, "unknown setting '" + key + "'"});
+    return 0;
+  };
+  for (const auto& [key, value] : o.named)
+    if (!value->empty())
+      if (int rc = apply(key, *value)) return rc;
+  for (const std::string& kv : o.sets) {
+    const auto eq = kv.find('=');
+    if (eq == std::string::npos)
+      return report_error(
+          {Status::invalid_argument, "--set: expected KEY=VALUE, got '" + kv + "'"});
+    if (int rc = apply(kv.substr(0, eq), kv.substr(eq + 1))) return rc;
+  }
+  if (auto v = validate_config(cfg); !v) return report_error(v.error());
+  if (!o.planar)
+    return report_error({Status::unsupported,
+                         "non-planar slicing is not available yet in this build; pass --planar"});
+  if (!o.mesh.quiet)
+    for (const auto& n : cfg.notes) std::fprintf(stderr, "warning: %s\n", n.c_str());
+
+  Context ctx = make_context(o.mesh.quiet);
+  LoadParams lp = o.mesh.load;
+  lp.bed_center = cfg.bed_center();
+  auto loaded = load_mesh(o.mesh.model, lp, ctx);
+  if (!loaded) return finish_progress(), report_error(loaded.error());
+  const BoundingBox box = bounding_box(loaded->mesh);
+  const Vec2 bed = cfg.bed_max - cfg.bed_min;
+  if (box.size().x() > bed.x() + 1e-6 || box.size().y() > bed.y() + 1e-6)
+    return finish_progress(),
+           report_error({Status::invalid_argument,
+                         o.mesh.model + ": part is " + std::to_string(box.size().x()) + " x " +
+                             std::to_string(box.size().y()) + " mm, larger than the bed (" +
+                             std::to_string(bed.x()) + " x " + std::to_string(bed.y()) + " mm)"});
+  auto layers = slice_mesh(loaded->mesh, cfg.slice, ctx);
+  if (!layers) return finish_progress(), report_error(layers.error());
+  auto paths = make_toolpaths(*layers, cfg.paths, ctx);
+  if (!paths) return finish_progress(), report_error(paths.error());
+  const std::vector<std::string> header = {"mode: planar", "model: " + o.mesh.model};
+  auto w = write_gcode_file(o.output, *paths, cfg, header, ctx);
+  finish_progress();
+  if (!w) return report_error(w.error());
+  report_warnings(o.mesh.model, *loaded, o.mesh.quiet);
+  if (!o.mesh.quiet)
+    std::fprintf(stderr, "wrote %s: %zu layers\n", o.output.c_str(), paths->size());
+  return kExitOk;
+}
+
+}  // namespace
+
+void register_slice(CLI::App& app, std::function<int()>* run_fn) {
+  auto o = std::make_shared<SliceOptions>();
+  CLI::App* cmd = app.add_subcommand(
+      "slice",
+      "Slice a model into G-code. Defaults print on a generic 0.4 mm nozzle Marlin 2 printer\n"
+      "with a 220 x 220 mm bed; --config loads a JSON profile or a PrusaSlicer .ini, and\n"
+      "the options below (or --set KEY=VALUE with any PrusaSlicer key) override it.");
+  o->mesh.add_to(*cmd);
+  cmd->add_option("-o,--output", o->output, "G-code file to write (atomically)")->required();
+  cmd->add_option("--config", o->config, "Profile: .json or PrusaSlicer .ini");
+  cmd->add_flag("--planar", o->planar, "Planar layers only (the ordinary slicing engine)");
+  static const char* keys[][2] = {
+      {"layer_height", "Layer height (mm)"},
+      {"first_layer_height", "First layer height (mm or %)"},
+      {"fill_density", "Sparse infill density (0.2 or 20%)"},
+      {"fill_pattern", "rectilinear or grid"},
+      {"perimeters", "Perimeter loops"},
+      {"top_solid_layers", "Solid layers under top surfaces"},
+      {"bottom_solid_layers", "Solid layers over bottom surfaces"},
+      {"temperature", "Nozzle temperature (C)"},
+      {"bed_temperature", "Bed temperature (C)"},
+      {"nozzle_diameter", "Nozzle diameter (mm)"},
+      {"filament_diameter", "Filament diameter (mm)"},
+      {"extrusion_width", "Extrusion width (mm or % of nozzle)"},
+      {"retract_length", "Retraction length (mm)"},
+      {"retract_lift", "Z-hop on retraction (mm)"},
+      {"skirts", "Skirt loops"},
+      {"gcode_flavor", "marlin2, klipper or reprapfirmware"},
+      {"use_relative_e_distances", "1 for relative E (M83)"},
+  };
+  static std::vector<std::string> values(std::size(keys));
+  for (std::size_t i = 0; i < std::size(keys); ++i) {
+    std::string flag = std::string("--") + keys[i][0];
+    for (char& ch : flag)
+      if (ch == '_') ch = '-';
+    if (flag == "--use-relative-e-distances") flag = "--relative-e";
+    cmd->add_option(flag, values[i], keys[i][1]);
+    o->named.emplace_back(keys[i][0], &values[i]);
+  }
+  cmd->add_option("--set", o->sets, "Any setting by its PrusaSlicer key: --set KEY=VALUE");
+  *run_fn = nullptr;
+  cmd->callback([o, run_fn] { *run_fn = [o] { return run(*o); }; });
+}
+
+}  // namespace nonplanar::cli

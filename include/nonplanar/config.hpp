@@ -1,0 +1,91 @@
+// Print configuration: one typed settings struct per stage, built once from a JSON profile
+// or a PrusaSlicer .ini, with command-line overrides (DESIGN.md §5). Millimetres, seconds
+// (speeds in mm/s), degrees, °C. No global settings object: stages get their own struct.
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "nonplanar/mesh.hpp"
+#include "nonplanar/status.hpp"
+
+namespace nonplanar {
+
+/// Inputs of slice_mesh.
+struct SliceParams {
+  double layer_height = 0.2;
+  double first_layer_height = 0.2;
+};
+
+enum class InfillPattern { rectilinear, grid };
+
+/// Inputs of make_toolpaths.
+struct ToolpathParams {
+  double nozzle_diameter = 0.4;
+  double extrusion_width = 0.45;  ///< perimeters and infill
+  double external_perimeter_width = 0.45;
+  double first_layer_width = 0.5;
+  int perimeters = 2;
+  int top_solid_layers = 5;
+  int bottom_solid_layers = 4;
+  double fill_density = 0.2;  ///< 0 … 1
+  InfillPattern fill_pattern = InfillPattern::rectilinear;
+  double fill_angle = 45;  ///< degrees; alternates ±90 per layer
+  int skirts = 1;
+  double skirt_distance = 6;
+  // Speeds (mm/s).
+  double perimeter_speed = 45, external_perimeter_speed = 25, infill_speed = 80,
+         solid_infill_speed = 60, top_solid_infill_speed = 40, first_layer_speed = 20,
+         travel_speed = 150;
+};
+
+enum class GcodeFlavor { marlin2, klipper, reprapfirmware };
+
+/// Inputs of write_gcode.
+struct GcodeParams {
+  GcodeFlavor flavor = GcodeFlavor::marlin2;
+  bool relative_e = false;
+  double filament_diameter = 1.75;
+  double extrusion_multiplier = 1.0;
+  double temperature = 210, first_layer_temperature = 215;
+  double bed_temperature = 60, first_layer_bed_temperature = 60;
+  double retract_length = 0.8, retract_speed = 35, deretract_speed = 0;  ///< 0: retract_speed
+  double retract_before_travel = 2.0;  ///< travels shorter than this are not retracted
+  double retract_lift = 0.0;           ///< z-hop
+  int fan_speed = 100;                 ///< percent, from layer disable_fan_first_layers on
+  int disable_fan_first_layers = 1;
+  std::string start_gcode =
+      "G28 ; home all axes\nG1 Z5 F5000 ; lift nozzle\nG92 E0\n"
+      "G1 X2 Y20 Z0.3 F6000\nG1 Y200 E15 F1200 ; purge line\nG92 E0\n";
+  std::string end_gcode =
+      "M104 S0 ; heater off\nM140 S0 ; bed off\nM107\nG91\nG1 Z10 F600\nG90\nM84\n";
+};
+
+/// Everything a print needs.
+struct PrintConfig {
+  Vec2 bed_min{0, 0}, bed_max{220, 220};  ///< bed_shape's bounding box
+  SliceParams slice;
+  ToolpathParams paths;
+  GcodeParams gcode;
+  std::vector<std::string> notes;  ///< settings that were read but adapted (shown as warnings)
+  Vec2 bed_center() const { return 0.5 * (bed_min + bed_max); }
+};
+
+/// Sets one setting by its PrusaSlicer key (e.g. "layer_height", "fill_density" = "20%",
+/// "bed_shape" = "0x0,220x0,220x220,0x220", "gcode_flavor" = "marlin2"). Unknown keys are
+/// ignored (returns false); a bad value is an invalid_argument error naming the key.
+Expected<bool> set_config_value(PrintConfig& c, const std::string& key, const std::string& value);
+
+/// Checks ranges (finite, positive heights, density in [0, 1], ...). Error names the key.
+Expected<bool> validate_config(const PrintConfig& c);
+
+/// Loads a JSON profile ({"layer_height": 0.2, ...}, keys as above) or a PrusaSlicer .ini
+/// (key = value lines) over the defaults. Error: "FILE: line N: problem".
+Expected<PrintConfig> load_config(const std::filesystem::path& file);
+
+/// Parses .ini text / JSON text over `base` (for tests and fuzzing).
+Expected<PrintConfig> parse_ini_config(std::string_view text, PrintConfig base = {});
+Expected<PrintConfig> parse_json_config(std::string_view text, PrintConfig base = {});
+
+}  // namespace nonplanar

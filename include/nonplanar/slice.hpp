@@ -1,0 +1,34 @@
+// Stage slice: planar contours of a closed mesh, as polygons with holes, per layer.
+#pragma once
+
+#include <vector>
+
+#include "nonplanar/config.hpp"
+#include "nonplanar/context.hpp"
+
+namespace nonplanar {
+
+/// A closed polygon in XY (mm); contours counter-clockwise, holes clockwise.
+using Polygon = std::vector<Vec2>;
+
+struct ExPolygon {
+  Polygon contour;
+  std::vector<Polygon> holes;
+};
+
+struct SlicedLayer {
+  double z_bottom = 0, z_top = 0;  ///< the layer's span, mm
+  double z_slice = 0;              ///< where the mesh was cut (mid-layer)
+  std::vector<ExPolygon> islands;
+};
+
+/// Cuts the mesh at the middle of every layer (first layer first_layer_height, then
+/// layer_height), chains the segments into loops through the mesh's edges, closes small
+/// gaps and unions overlapping shells (non-zero rule). Parallel over layers.
+Expected<std::vector<SlicedLayer>> slice_mesh(const TriangleMesh& mesh, const SliceParams& params,
+                                              const Context& ctx);
+
+/// Area of polygons with holes, mm².
+double area(const std::vector<ExPolygon>& polys);
+
+}  // namespace nonplanar

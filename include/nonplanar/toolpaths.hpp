@@ -1,0 +1,46 @@
+// Stage toolpaths: perimeters, skins, infill and skirt for every layer, ordered, each path
+// carrying its own height per point so non-planar paths can use the same types.
+#pragma once
+
+#include <vector>
+
+#include "nonplanar/slice.hpp"
+
+namespace nonplanar {
+
+enum class ExtrusionRole {
+  external_perimeter,
+  perimeter,
+  internal_infill,
+  solid_infill,
+  top_solid_infill,
+  skirt,
+};
+/// PrusaSlicer's ;TYPE: names ("External perimeter", "Internal infill", "Skirt/Brim", ...).
+const char* role_name(ExtrusionRole r);
+
+/// One extrusion: a polyline (closed loops repeat their first point at the end). points[i]
+/// carries its z; height[i] is the layer thickness under point i (mm); width in mm.
+struct ExtrusionPath {
+  ExtrusionRole role = ExtrusionRole::perimeter;
+  double width = 0.45;
+  double speed = 40;  ///< mm/s
+  std::vector<Vec3> points;
+  std::vector<double> height;
+};
+
+struct LayerToolpaths {
+  double z = 0, height = 0.2;        ///< nominal top of the layer and its thickness
+  std::vector<ExtrusionPath> paths;  ///< in print order
+};
+
+/// Builds the paths of every layer from its islands. Errors: invalid_argument, cancelled.
+Expected<std::vector<LayerToolpaths>> make_toolpaths(const std::vector<SlicedLayer>& layers,
+                                                     const ToolpathParams& params,
+                                                     const Context& ctx);
+
+/// Centre-line spacing of adjacent beads of width w and height h (Slic3r's bead: a
+/// rectangle with semicircular ends): w − h·(1 − π/4). A bead's cross-section is h·spacing.
+double bead_spacing(double width, double height);
+
+}  // namespace nonplanar

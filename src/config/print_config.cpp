@@ -1,0 +1,258 @@
+// Setting values by PrusaSlicer key: the one place where settings are string-keyed.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <optional>
+#include <sstream>
+
+#include "io/mesh_buffer.hpp"
+#include "nonplanar/config.hpp"
+
+namespace nonplanar {
+namespace {
+
+Error bad(const std::string& key, const std::string& why) {
+  return Error{Status::invalid_argument, key + ": " + why};
+}
+
+// First value of a comma-separated list (PrusaSlicer writes one per extruder).
+std::string first_item(const std::string& v) {
+  const auto c = v.find(',');
+  std::string s = c == std::string::npos ? v : v.substr(0, c);
+  s.erase(0, s.find_first_not_of(" \t"));
+  s.erase(s.find_last_not_of(" \t\r") + 1);
+  return s;
+}
+
+std::optional<double> number(const std::string& v) {
+  return io::parse_double(first_item(v));
+}
+
+// "45" or "50%" (of `base`).
+std::optional<double> number_or_percent(const std::string& v, double base) {
+  std::string s = first_item(v);
+  if (!s.empty() && s.back() == '%') {
+    const auto d = io::parse_double(s.substr(0, s.size() - 1));
+    return d ? std::optional<double>(*d / 100.0 * base) : std::nullopt;
+  }
+  return io::parse_double(s);
+}
+
+// PrusaSlicer stores G-code templates with \n escapes.
+std::string unescape(const std::string& v) {
+  std::string out;
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    if (v[i] == '\\' && i + 1 < v.size()) {
+      const char n = v[++i];
+      out += n == 'n' ? '\n' : n == 't' ? '\t' : n == 'r' ? '\r' : n;
+    } else {
+      out += v[i];
+    }
+  }
+  if (out.size() >= 2 && out.front() == '"' && out.back() == '"')
+    out = out.substr(1, out.size() - 2);
+  return out;
+}
+
+}  // namespace
+
+Expected<bool> set_config_value(PrintConfig& c, const std::string& key, const std::string& value) {
+  ToolpathParams& t = c.paths;
+  GcodeParams& g = c.gcode;
+  auto num = [&](double& field) -> Expected<bool> {
+    const auto d = number(value);
+    if (!d) return bad(key, "'" + value + "' is not a finite number");
+    field = *d;
+    return true;
+  };
+  auto integer = [&](int& field) -> Expected<bool> {
+    const auto d = number(value);
+    if (!d || *d != std::floor(*d) || std::abs(*d) > 1e6)
+      return bad(key, "'" + value + "' is not a whole number");
+    field = static_cast<int>(*d);
+    return true;
+  };
+  auto pct = [&](double& field, double base) -> Expected<bool> {
+    const auto d = number_or_percent(value, base);
+    if (!d) return bad(key, "'" + value + "' is not a number or a percentage");
+    field = *d;
+    return true;
+  };
+  // Widths: 0 means "auto" (1.125 × nozzle, as PrusaSlicer); percentages are of the nozzle.
+  auto width = [&](double& field) -> Expected<bool> {
+    const auto d = number_or_percent(value, t.nozzle_diameter);
+    if (!d) return bad(key, "'" + value + "' is not a width");
+    field = *d == 0 ? 1.125 * t.nozzle_diameter : *d;
+    return true;
+  };
+  if (key == "layer_height") return num(c.slice.layer_height);
+  if (key == "first_layer_height") return pct(c.slice.first_layer_height, c.slice.layer_height);
+  if (key == "nozzle_diameter") return num(t.nozzle_diameter);
+  if (key == "filament_diameter") return num(g.filament_diameter);
+  if (key == "extrusion_multiplier") return num(g.extrusion_multiplier);
+  if (key == "perimeters") return integer(t.perimeters);
+  if (key == "top_solid_layers") return integer(t.top_solid_layers);
+  if (key == "bottom_solid_layers") return integer(t.bottom_solid_layers);
+  if (key == "fill_density") {
+    auto r = pct(t.fill_density, 1.0);
+    // "0.2" and "20%" both mean 20 %; a bare number above 1 is a percentage too.
+    if (r && t.fill_density > 1.0 && value.find('%') == std::string::npos) t.fill_density /= 100.0;
+    return r;
+  }
+  if (key == "fill_pattern") {
+    const std::string v = first_item(value);
+    if (v == "rectilinear" || v == "alignedrectilinear" || v == "line" || v == "monotonic")
+      t.fill_pattern = InfillPattern::rectilinear;
+    else if (v == "grid")
+      t.fill_pattern = InfillPattern::grid;
+    else {
+      t.fill_pattern = InfillPattern::grid;
+      c.notes.push_back("fill_pattern " + v + " is not supported; using grid");
+    }
+    return true;
+  }
+  if (key == "fill_angle") return num(t.fill_angle);
+  if (key == "skirts") return integer(t.skirts);
+  if (key == "skirt_distance") return num(t.skirt_distance);
+  if (key == "extrusion_width" || key == "perimeter_extrusion_width" ||
+      key == "infill_extrusion_width")
+    return width(t.extrusion_width);
+  if (key == "external_perimeter_extrusion_width") return width(t.external_perimeter_width);
+  if (key == "first_layer_extrusion_width") return width(t.first_layer_width);
+  if (key == "perimeter_speed") return num(t.perimeter_speed);
+  if (key == "external_perimeter_speed") return pct(t.external_perimeter_speed, t.perimeter_speed);
+  if (key == "infill_speed") return num(t.infill_speed);
+  if (key == "solid_infill_speed") return pct(t.solid_infill_speed, t.infill_speed);
+  if (key == "top_solid_infill_speed") return pct(t.top_solid_infill_speed, t.solid_infill_speed);
+  if (key == "first_layer_speed") return pct(t.first_layer_speed, t.perimeter_speed);
+  if (key == "travel_speed") return num(t.travel_speed);
+  if (key == "temperature") return num(g.temperature);
+  if (key == "first_layer_temperature") return num(g.first_layer_temperature);
+  if (key == "bed_temperature") return num(g.bed_temperature);
+  if (key == "first_layer_bed_temperature") return num(g.first_layer_bed_temperature);
+  if (key == "retract_length") return num(g.retract_length);
+  if (key == "retract_speed") return num(g.retract_speed);
+  if (key == "deretract_speed") return num(g.deretract_speed);
+  if (key == "retract_before_travel") return num(g.retract_before_travel);
+  if (key == "retract_lift") return num(g.retract_lift);
+  if (key == "max_fan_speed") return integer(g.fan_speed);
+  if (key == "disable_fan_first_layers") return integer(g.disable_fan_first_layers);
+  if (key == "use_relative_e_distances") {
+    const std::string v = first_item(value);
+    if (v != "0" && v != "1" && v != "true" && v != "false") return bad(key, "expected 0 or 1");
+    g.relative_e = v == "1" || v == "true";
+    return true;
+  }
+  if (key == "gcode_flavor") {
+    const std::string v = first_item(value);
+    if (v == "marlin2" || v == "marlin" || v == "marlinlegacy")
+      g.flavor = GcodeFlavor::marlin2;
+    else if (v == "klipper")
+      g.flavor = GcodeFlavor::klipper;
+    else if (v == "reprapfirmware" || v == "reprap" || v == "rrf")
+      g.flavor = GcodeFlavor::reprapfirmware;
+    else
+      return bad(key, "'" + v + "' is not marlin2, klipper or reprapfirmware");
+    return true;
+  }
+  if (key == "start_gcode") return g.start_gcode = unescape(value), true;
+  if (key == "end_gcode") return g.end_gcode = unescape(value), true;
+  if (key == "bed_shape") {
+    // "0x0,220x0,220x220,0x220": the bounding box of the corners.
+    Vec2 lo(1e300, 1e300), hi(-1e300, -1e300);
+    std::stringstream ss(value);
+    std::string item;
+    int n = 0;
+    while (std::getline(ss, item, ',')) {
+      const auto x = item.find('x');
+      const auto a =
+          x == std::string::npos ? std::nullopt : io::parse_double(first_item(item.substr(0, x)));
+      const auto b =
+          x == std::string::npos ? std::nullopt : io::parse_double(first_item(item.substr(x + 1)));
+      if (!a || !b) return bad(key, "'" + item + "' is not XxY");
+      lo = lo.cwiseMin(Vec2(*a, *b));
+      hi = hi.cwiseMax(Vec2(*a, *b));
+      ++n;
+    }
+    if (n < 3) return bad(key, "needs at least 3 corners");
+    c.bed_min = lo;
+    c.bed_max = hi;
+    return true;
+  }
+  return false;
+}
+
+Expected<bool> validate_config(const PrintConfig& c) {
+  auto pos = [](double v) { return std::isfinite(v) && v > 0; };
+  const ToolpathParams& t = c.paths;
+  const GcodeParams& g = c.gcode;
+  if (!pos(c.slice.layer_height)) return bad("layer_height", "must be a finite number > 0");
+  if (!pos(c.slice.first_layer_height))
+    return bad("first_layer_height", "must be a finite number > 0");
+  if (!pos(t.nozzle_diameter)) return bad("nozzle_diameter", "must be a finite number > 0");
+  if (c.slice.layer_height > t.nozzle_diameter)
+    return bad("layer_height", "is larger than the nozzle diameter");
+  if (!pos(g.filament_diameter)) return bad("filament_diameter", "must be a finite number > 0");
+  if (!pos(g.extrusion_multiplier)) return bad("extrusion_multiplier", "must be > 0");
+  for (const auto& [k, v] : {std::pair{"extrusion_width", t.extrusion_width},
+                             {"external_perimeter_extrusion_width", t.external_perimeter_width},
+                             {"first_layer_extrusion_width", t.first_layer_width}})
+    if (!pos(v) || v < c.slice.layer_height) return bad(k, "must be at least the layer height");
+  if (t.perimeters < 0 || t.perimeters > 100) return bad("perimeters", "must be 0 to 100");
+  if (t.top_solid_layers < 0 || t.bottom_solid_layers < 0)
+    return bad("top_solid_layers/bottom_solid_layers", "must be >= 0");
+  if (!std::isfinite(t.fill_density) || t.fill_density < 0 || t.fill_density > 1)
+    return bad("fill_density", "must be in 0 % … 100 %");
+  for (const auto& [k, v] : {std::pair{"perimeter_speed", t.perimeter_speed},
+                             {"external_perimeter_speed", t.external_perimeter_speed},
+                             {"infill_speed", t.infill_speed},
+                             {"solid_infill_speed", t.solid_infill_speed},
+                             {"top_solid_infill_speed", t.top_solid_infill_speed},
+                             {"first_layer_speed", t.first_layer_speed},
+                             {"travel_speed", t.travel_speed},
+                             {"retract_speed", g.retract_speed}})
+    if (!pos(v)) return bad(k, "must be a finite speed > 0");
+  for (const auto& [k, v] : {std::pair{"temperature", g.temperature},
+                             {"first_layer_temperature", g.first_layer_temperature},
+                             {"bed_temperature", g.bed_temperature},
+                             {"first_layer_bed_temperature", g.first_layer_bed_temperature}})
+    if (!std::isfinite(v) || v < 0 || v > 500) return bad(k, "must be 0 to 500 °C");
+  for (const auto& [k, v] : {std::pair{"retract_length", g.retract_length},
+                             {"retract_before_travel", g.retract_before_travel},
+                             {"retract_lift", g.retract_lift},
+                             {"skirt_distance", t.skirt_distance}})
+    if (!std::isfinite(v) || v < 0) return bad(k, "must be a finite number >= 0");
+  if (!c.bed_min.allFinite() || !c.bed_max.allFinite() || !(c.bed_max.x() > c.bed_min.x()) ||
+      !(c.bed_max.y() > c.bed_min.y()))
+    return bad("bed_shape", "is empty");
+  return true;
+}
+
+Expected<PrintConfig> parse_ini_config(std::string_view text, PrintConfig c) {
+  std::size_t pos = 0;
+  int line = 0;
+  while (pos < text.size()) {
+    std::size_t end = text.find('\n', pos);
+    if (end == std::string_view::npos) end = text.size();
+    std::string l(text.substr(pos, end - pos));
+    pos = end + 1;
+    ++line;
+    if (!l.empty() && l.back() == '\r') l.pop_back();
+    const auto first = l.find_first_not_of(" \t");
+    if (first == std::string::npos || l[first] == '#' || l[first] == ';' || l[first] == '[')
+      continue;
+    const auto eq = l.find('=');
+    if (eq == std::string::npos)
+      return Error{Status::parse_error, "line " + std::to_string(line) + ": expected key = value"};
+    std::string key = l.substr(first, eq - first), value = l.substr(eq + 1);
+    key.erase(key.find_last_not_of(" \t") + 1);
+    value.erase(0, value.find_first_not_of(" \t"));
+    auto r = set_config_value(c, key, value);
+    if (!r)
+      return Error{Status::parse_error, "line " + std::to_string(line) + ": " + r.error().message};
+  }
+  if (auto v = validate_config(c); !v) return v.error();
+  return c;
+}
+
+}  // namespace nonplanar

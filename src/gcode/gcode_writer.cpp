@@ -1,0 +1,223 @@
+// The G-code emitter: position, extrusion (absolute or relative), feed rate, retraction,
+// flavour; PrusaSlicer's preview annotations; no arcs. Text is built in memory and written
+// atomically, so a half-written file never exists under the final name.
+#include <cinttypes>
+#include <cmath>
+#include <cstdarg>
+#include <cstdio>
+#include <string>
+
+#include "core/atomic_file.hpp"
+#include "nonplanar/gcode.hpp"
+
+namespace nonplanar {
+
+double filament_per_mm(double width, double height, const GcodeParams& g) {
+  const double area = height * bead_spacing(width, height);  // rectangle with round ends
+  const double filament = M_PI * 0.25 * g.filament_diameter * g.filament_diameter;
+  return area / filament * g.extrusion_multiplier;
+}
+
+namespace {
+
+const char* flavor_name(GcodeFlavor f) {
+  switch (f) {
+    case GcodeFlavor::marlin2:
+      return "marlin2";
+    case GcodeFlavor::klipper:
+      return "klipper";
+    case GcodeFlavor::reprapfirmware:
+      return "reprapfirmware";
+  }
+  return "marlin2";
+}
+
+// Replaces {key}, [key], {key[0]} and [key[0]] for the keys we know.
+std::string expand(std::string t, const PrintConfig& c) {
+  const GcodeParams& g = c.gcode;
+  const std::pair<const char*, double> vars[] = {
+      {"first_layer_bed_temperature", g.first_layer_bed_temperature},
+      {"first_layer_temperature", g.first_layer_temperature},
+      {"bed_temperature", g.bed_temperature},
+      {"temperature", g.temperature},
+      {"first_layer_height", c.slice.first_layer_height},
+      {"layer_height", c.slice.layer_height},
+      {"nozzle_diameter", c.paths.nozzle_diameter},
+      {"filament_diameter", g.filament_diameter}};
+  for (const auto& [name, v] : vars) {
+    char num[32];
+    std::snprintf(num, sizeof num, "%g", v);
+    for (const std::string& open : {std::string("{"), std::string("[")}) {
+      const std::string close = open == "{" ? "}" : "]";
+      for (const std::string& suffix :
+           {std::string(), std::string("[0]"), std::string("[initial_extruder]")}) {
+        const std::string key = open + name + suffix + close;
+        for (std::size_t p = t.find(key); p != std::string::npos; p = t.find(key, p))
+          t.replace(p, key.size(), num);
+      }
+    }
+  }
+  if (!t.empty() && t.back() != '\n') t += '\n';
+  return t;
+}
+
+class Emitter {
+ public:
+  Emitter(const PrintConfig& c) : c_(c), g_(c.gcode) {}
+  std::string out;
+
+  void raw(const std::string& s) { out += s; }
+  void comment(const std::string& s) { out += ";" + s + "\n"; }
+  void line(const char* f, ...) __attribute__((format(printf, 2, 3))) {
+    char buf[256];
+    va_list ap;
+    va_start(ap, f);
+    std::vsnprintf(buf, sizeof buf, f, ap);
+    va_end(ap);
+    out += buf;
+    out += '\n';
+  }
+  void fan(int percent) {
+    if (percent <= 0) return line("M107");
+    if (g_.flavor == GcodeFlavor::reprapfirmware) return line("M106 S%.2f", percent / 100.0);
+    line("M106 S%d", static_cast<int>(std::lround(2.55 * percent)));
+  }
+  void reset_e() {
+    if (!g_.relative_e) line("G92 E0"), e_ = 0;
+  }
+  void retract() {
+    if (retracted_ || g_.retract_length <= 0) return;
+    move_e(-g_.retract_length, g_.retract_speed, "retract");
+    retracted_ = true;
+  }
+  void unretract() {
+    if (!retracted_) return;
+    move_e(g_.retract_length, g_.deretract_speed > 0 ? g_.deretract_speed : g_.retract_speed,
+           "unretract");
+    retracted_ = false;
+  }
+  // Travel to p: lift and retract for long moves, never through the part at print height.
+  void travel(const Vec3& p, double speed) {
+    const double d = (p.head<2>() - pos_.head<2>()).norm();
+    if (!have_pos_) {
+      // Wherever the start G-code left the nozzle, the way to the print is long: retract.
+      retract();
+      line("G1 Z%.3f F%d", p.z(), static_cast<int>(speed * 60));
+      line("G1 X%.3f Y%.3f F%d", p.x(), p.y(), static_cast<int>(speed * 60));
+      pos_ = p, have_pos_ = true;
+      return;
+    }
+    if (d < 1e-6 && std::abs(p.z() - pos_.z()) < 1e-6) return;
+    const bool long_move = d > g_.retract_before_travel;
+    if (long_move) retract();
+    if (long_move && g_.retract_lift > 0)
+      line("G1 Z%.3f F%d", std::max(pos_.z(), p.z()) + g_.retract_lift,
+           static_cast<int>(speed * 60));
+    else if (p.z() > pos_.z() + 1e-9)
+      line("G1 Z%.3f F%d", p.z(), static_cast<int>(speed * 60));
+    line("G1 X%.3f Y%.3f F%d", p.x(), p.y(), static_cast<int>(speed * 60));
+    if ((long_move && g_.retract_lift > 0) || p.z() < pos_.z() - 1e-9)
+      line("G1 Z%.3f F%d", p.z(), static_cast<int>(speed * 60));
+    pos_ = p;
+  }
+  void extrude(const Vec3& p, double de, double speed) {
+    unretract();
+    e_ += de;
+    const double e = g_.relative_e ? de : e_;
+    if (std::abs(p.z() - pos_.z()) > 1e-9)
+      line("G1 X%.3f Y%.3f Z%.3f E%.5f F%d", p.x(), p.y(), p.z(), e, static_cast<int>(speed * 60));
+    else
+      line("G1 X%.3f Y%.3f E%.5f F%d", p.x(), p.y(), e, static_cast<int>(speed * 60));
+    pos_ = p;
+  }
+  double total_e = 0;
+
+ private:
+  void move_e(double de, double speed, const char* what) {
+    e_ += de;
+    line("G1 E%.5f F%d ; %s", g_.relative_e ? de : e_, static_cast<int>(speed * 60), what);
+  }
+  const PrintConfig& c_;
+  const GcodeParams& g_;
+  Vec3 pos_ = Vec3::Zero();
+  bool have_pos_ = false, retracted_ = false;
+  double e_ = 0;
+};
+
+}  // namespace
+
+Expected<std::string> make_gcode(const std::vector<LayerToolpaths>& layers, const PrintConfig& c,
+                                 const std::vector<std::string>& header, const Context& ctx) {
+  const GcodeParams& g = c.gcode;
+  Emitter em(c);
+  em.out.reserve(1 << 20);
+  em.comment(" generated by nonplanar 0.1.0");
+  for (const auto& h : header) em.comment(" " + h);
+  em.line(";FLAVOR:%s", flavor_name(g.flavor));
+  em.line("M140 S%g", g.first_layer_bed_temperature);
+  em.line("M104 S%g", g.first_layer_temperature);
+  const std::string start = expand(g.start_gcode, c);
+  if (start.find("M190") == std::string::npos) em.line("M190 S%g", g.first_layer_bed_temperature);
+  if (start.find("M109") == std::string::npos) em.line("M109 S%g", g.first_layer_temperature);
+  em.line("G21 ; millimetres");
+  em.line("G90 ; absolute XYZ");
+  em.line(g.relative_e ? "M83 ; relative E" : "M82 ; absolute E");
+  em.raw(start);
+  em.line("G92 E0");
+  double filament = 0;
+  for (std::size_t i = 0; i < layers.size(); ++i) {
+    if (ctx.cancelled()) return Error{Status::cancelled, "cancelled"};
+    const LayerToolpaths& L = layers[i];
+    em.comment("LAYER_CHANGE");
+    em.line(";Z:%.3f", L.z);
+    em.line(";HEIGHT:%.3f", L.height);
+    em.reset_e();
+    if (i == 1) {
+      if (g.temperature != g.first_layer_temperature) em.line("M104 S%g", g.temperature);
+      if (g.bed_temperature != g.first_layer_bed_temperature)
+        em.line("M140 S%g", g.bed_temperature);
+    }
+    if (static_cast<int>(i) == g.disable_fan_first_layers) em.fan(g.fan_speed);
+    ExtrusionRole role = ExtrusionRole::skirt;
+    double width = -1;
+    bool first = true;
+    for (const ExtrusionPath& p : L.paths) {
+      if (p.points.size() < 2) continue;
+      em.travel(p.points.front(), c.paths.travel_speed);
+      if (first || p.role != role) em.line(";TYPE:%s", role_name(p.role));
+      if (first || std::abs(p.width - width) > 1e-9) em.line(";WIDTH:%.3f", p.width);
+      first = false;
+      role = p.role, width = p.width;
+      for (std::size_t k = 1; k < p.points.size(); ++k) {
+        const double len = (p.points[k] - p.points[k - 1]).norm();
+        if (len < 1e-6) continue;
+        // Each segment's own height sets its extrusion (non-planar paths vary).
+        const double h = 0.5 * (p.height[k] + p.height[k - 1]);
+        const double de = len * filament_per_mm(p.width, h, g);
+        filament += de;
+        em.extrude(p.points[k], de, p.speed);
+      }
+    }
+    em.retract();
+    ctx.progress("gcode", static_cast<double>(i + 1) / static_cast<double>(layers.size()));
+  }
+  em.fan(0);
+  em.raw(expand(g.end_gcode, c));
+  em.line("; filament used [mm] = %.2f", filament);
+  em.line("; filament used [cm3] = %.3f",
+          filament * M_PI * 0.25 * g.filament_diameter * g.filament_diameter / 1000.0);
+  return std::move(em.out);
+}
+
+Expected<bool> write_gcode_file(const std::filesystem::path& file,
+                                const std::vector<LayerToolpaths>& layers, const PrintConfig& c,
+                                const std::vector<std::string>& header, const Context& ctx) {
+  auto text = make_gcode(layers, c, header, ctx);
+  if (!text) return text.error();
+  return write_file_atomically(file, [&](std::ostream& out) {
+    out.write(text->data(), static_cast<std::streamsize>(text->size()));
+    return bool(out);
+  });
+}
+
+}  // namespace nonplanar

@@ -1,0 +1,186 @@
+// End-to-end planar prints, read back by the strict test reader.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "core/column_caster.hpp"
+#include "nonplanar/gcode.hpp"
+#include "support/files.hpp"
+#include "support/gcode_reader.hpp"
+#include "support/solids.hpp"
+
+namespace nonplanar {
+namespace {
+
+struct Printed {
+  TriangleMesh mesh;
+  test::Program prog;
+  std::string text;
+};
+
+Printed print(TriangleMesh mesh, const PrintConfig& c) {
+  // Place as the loader does: centre on the bed, lowest point at 0.
+  const BoundingBox b = bounding_box(mesh);
+  const Vec3 shift(c.bed_center().x() - 0.5 * (b.min.x() + b.max.x()),
+                   c.bed_center().y() - 0.5 * (b.min.y() + b.max.y()), -b.min.z());
+  for (Vec3& v : mesh.vertices) v += shift;
+  auto layers = slice_mesh(mesh, c.slice, {});
+  EXPECT_TRUE(layers);
+  auto paths = make_toolpaths(*layers, c.paths, {});
+  EXPECT_TRUE(paths);
+  auto text = make_gcode(*paths, c, {"test"}, {});
+  EXPECT_TRUE(text);
+  Printed p{std::move(mesh), test::read_gcode(*text), *text};
+  EXPECT_EQ(p.prog.error, "");
+  return p;
+}
+
+double filament_volume(const test::Program& prog, double d, bool skip_skirt = true) {
+  double e = 0;
+  for (const auto& m : prog.moves)
+    if (m.layer >= 0 && !m.travel && !(skip_skirt && m.type == "Skirt/Brim")) e += m.de;
+  return e * M_PI * 0.25 * d * d;
+}
+
+TEST(PlanarPrint, CubeAtFullInfillExtrudesItsVolume) {
+  PrintConfig c;
+  c.paths.fill_density = 1.0;
+  const Printed p = print(test::box({0, 0, 0}, {20, 20, 20}), c);
+  const double ratio = filament_volume(p.prog, c.gcode.filament_diameter) / 8000.0;
+  EXPECT_NEAR(ratio, 1.0, 0.03);
+  ASSERT_EQ(p.prog.layer_z.size(), 100u);
+  EXPECT_NEAR(p.prog.layer_z.front(), 0.2, 1e-9);
+  EXPECT_NEAR(p.prog.layer_z.back(), 20.0, 1e-9);
+  // Perimeters per layer: extrusion runs typed perimeter, counted between travels.
+  for (int layer = 0; layer < 100; layer += 9) {
+    int loops = 0;
+    bool in = false;
+    for (const auto& m : p.prog.moves) {
+      if (m.layer != layer) continue;
+      const bool per = !m.travel && (m.type == "Perimeter" || m.type == "External perimeter");
+      if (per && !in) ++loops;
+      in = per || (in && !m.travel);
+      if (m.travel && std::hypot(m.to.x() - m.from.x(), m.to.y() - m.from.y()) > 1e-9) in = false;
+    }
+    EXPECT_EQ(loops, c.paths.perimeters) << "layer " << layer;
+  }
+}
+
+TEST(PlanarPrint, CylinderOuterPerimeterIsRMinusHalfWidth) {
+  PrintConfig c;
+  const double R = 10;
+  // 256-gon prism: the chord error (0.00075 mm) is far below the 0.01 mm tolerance.
+  const Printed p =
+      print(test::height_field_solid([](double, double) { return 6.0; }, -1, 1, -1, 1, 1, 1), c);
+  (void)p;
+  TriangleMesh cyl;
+  const int n = 256;
+  for (int i = 0; i < n; ++i) {
+    const double a = 2 * M_PI * i / n;
+    cyl.vertices.emplace_back(R * std::cos(a), R * std::sin(a), 0);
+    cyl.vertices.emplace_back(R * std::cos(a), R * std::sin(a), 6);
+  }
+  cyl.vertices.emplace_back(0, 0, 0);
+  cyl.vertices.emplace_back(0, 0, 6);
+  const int cb = 2 * n, ct = 2 * n + 1;
+  for (int i = 0; i < n; ++i) {
+    const int j = (i + 1) % n;
+    cyl.faces.push_back({2 * i, 2 * j, 2 * j + 1});
+    cyl.faces.push_back({2 * i, 2 * j + 1, 2 * i + 1});
+    cyl.faces.push_back({cb, 2 * j, 2 * i});
+    cyl.faces.push_back({ct, 2 * i + 1, 2 * j + 1});
+  }
+  ASSERT_NEAR(signed_volume(cyl), M_PI * R * R * 6, 1.0);
+  const Printed q = print(cyl, c);
+  const Vec2 centre = c.bed_center();
+  int checked = 0;
+  for (const auto& m : q.prog.moves) {
+    if (m.travel || m.type != "External perimeter") continue;
+    const double w = m.layer == 0 ? c.paths.first_layer_width : c.paths.external_perimeter_width;
+    EXPECT_NEAR((m.to.head<2>() - centre).norm(), R - w / 2, 0.01) << "layer " << m.layer;
+    ++checked;
+  }
+  EXPECT_GT(checked, 30 * 50);  // every layer's loop (collinear vertices are merged)
+}
+
+TEST(PlanarPrint, LongTravelsAreRetractedAndRestored) {
+  PrintConfig c;
+  TriangleMesh two = test::box({0, 0, 0}, {10, 10, 3});
+  test::append(two, test::box({30, 0, 0}, {40, 10, 3}));
+  const Printed p = print(two, c);
+  int long_travels = 0;
+  const auto& mv = p.prog.moves;
+  for (std::size_t i = 0; i < mv.size(); ++i) {
+    const double d = (mv[i].to.head<2>() - mv[i].from.head<2>()).norm();
+    if (!mv[i].travel || mv[i].de != 0 || d <= c.gcode.retract_before_travel || mv[i].layer < 0)
+      continue;
+    ++long_travels;
+    // The last E move before it is a retraction; the first E move after it restores it.
+    double before = 0, after = 0;
+    for (std::size_t k = i; k-- > 0;)
+      if (mv[k].de != 0) {
+        before = mv[k].de;
+        break;
+      }
+    for (std::size_t k = i + 1; k < mv.size(); ++k)
+      if (mv[k].de != 0) {
+        after = mv[k].de;
+        break;
+      }
+    EXPECT_NEAR(before, -c.gcode.retract_length, 1e-9) << "line " << mv[i].line;
+    EXPECT_NEAR(after, c.gcode.retract_length, 1e-9) << "line " << mv[i].line;
+  }
+  EXPECT_GT(long_travels, 15);  // at least one island hop per layer
+}
+
+TEST(PlanarPrint, EveryExtrusionLiesInsideTheMesh) {
+  PrintConfig c;
+  const TriangleMesh m = test::height_field_solid(
+      [](double x, double y) { return 5 + 0.1 * x + 0.05 * y; }, 0, 20, 0, 15, 20, 15);
+  const Printed p = print(m, c);
+  const ColumnCaster cols(p.mesh);
+  std::size_t total = 0, outside = 0;
+  for (const auto& mv : p.prog.moves) {
+    if (mv.travel || mv.layer < 0 || mv.type == "Skirt/Brim") continue;
+    ++total;
+    // The bead sits below the nozzle: test its middle.
+    if (!cols.inside(mv.to.x(), mv.to.y(), mv.to.z() - 0.5 * mv.height)) ++outside;
+  }
+  EXPECT_GT(total, 1000u);
+  EXPECT_EQ(outside, 0u);
+}
+
+TEST(PlanarPrint, PrusaSlicerIniReachesTheGcode) {
+  auto c = load_config(std::filesystem::path(NONPLANAR_TEST_DATA) / "prusaslicer_015mm_215C.ini");
+  ASSERT_TRUE(c) << c.error().message;
+  EXPECT_NEAR(c->slice.layer_height, 0.15, 1e-12);
+  EXPECT_EQ(c->paths.perimeters, 3);
+  EXPECT_EQ(c->gcode.flavor, GcodeFlavor::reprapfirmware);
+  EXPECT_EQ(c->bed_max, Vec2(200, 200));
+  EXPECT_FALSE(c->notes.empty());  // "stars" infill is not supported: noted, grid used
+  const Printed p = print(test::box({0, 0, 0}, {10, 10, 3}), *c);
+  EXPECT_NE(p.text.find("M109 S215"), std::string::npos);
+  EXPECT_NE(p.text.find("M140 S55"), std::string::npos);  // from the second layer on
+  EXPECT_NE(p.text.find(";HEIGHT:0.150"), std::string::npos);
+  EXPECT_NE(p.text.find("G28 ; home all axes"), std::string::npos);  // its start G-code
+  EXPECT_NEAR(p.prog.layer_z[1] - p.prog.layer_z[0], 0.15, 1e-9);
+}
+
+TEST(Config, BadValuesNameTheKeyAndLine) {
+  auto r = parse_ini_config("layer_height = 0.2\nfill_density = lots\n");
+  ASSERT_FALSE(r);
+  EXPECT_EQ(r.error().message, "line 2: fill_density: 'lots' is not a number or a percentage");
+  auto j = parse_json_config(R"({"layer_height": -1})");
+  ASSERT_FALSE(j);
+  EXPECT_EQ(j.error().message.rfind("layer_height:", 0), 0u);
+  EXPECT_FALSE(parse_ini_config("this line has no equals sign\n"));
+  EXPECT_FALSE(parse_json_config("[1, 2]"));
+  auto ok = parse_json_config(
+      R"({"fill_density": "35%", "temperature": 230, "use_relative_e_distances": true})");
+  ASSERT_TRUE(ok) << ok.error().message;
+  EXPECT_NEAR(ok->paths.fill_density, 0.35, 1e-12);
+  EXPECT_TRUE(ok->gcode.relative_e);
+}
+
+}  // namespace
+}  // namespace nonplanar
