@@ -23,7 +23,16 @@ std::vector<Polyline> infill_lines(const ExPolygons& region, double angle_deg, d
     const double t = (k + 0.5) * spacing;
     lines.push_back({t * nrm + (umin - 1) * dir, t * nrm + (umax + 1) * dir});
   }
-  return clip::clip_polylines(lines, area);
+  // Beads are extruded along their centre line only, so a line clipped s/2 inside the region
+  // would leave s/2 unfilled at each end: extend both ends back to the region's edge.
+  std::vector<Polyline> out = clip::clip_polylines(lines, area);
+  for (Polyline& l : out) {
+    if (l.size() < 2) continue;
+    const Vec2 d0 = (l[0] - l[1]).normalized(), d1 = (l.back() - l[l.size() - 2]).normalized();
+    if (d0.allFinite()) l.front() += 0.5 * s * d0;
+    if (d1.allFinite()) l.back() += 0.5 * s * d1;
+  }
+  return out;
 }
 
 }  // namespace nonplanar::paths

@@ -94,7 +94,9 @@ inline Program read_gcode(const std::string& text) {
         m.de = relative_e ? *ev : *ev - e;
         e = relative_e ? e + *ev : *ev;
       }
-      m.travel = !(m.de > 0);
+      // An E move without XY motion (a retraction or its restore) deposits nothing.
+      const bool moves_xy = (to.head<2>() - pos.head<2>()).norm() > 1e-9;
+      m.travel = !(m.de > 0 && moves_xy);
       prog.moves.push_back(m);
       pos = to;
     } else if (cmd == "G4" || cmd == "G21" || cmd == "G28" || cmd == "M84" || cmd == "M104" ||
