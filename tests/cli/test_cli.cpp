@@ -133,6 +133,45 @@ TEST(Cli, LayersReportsStacksAndWritesTheirFiles) {
   EXPECT_EQ(run("layers --max-layer-height 0.05 " + (dir / "roof.stl").string()).code, 2);
 }
 
+TEST(Cli, SlicePlanarWritesGcodeAndRefusesBadSettings) {
+  const auto dir = test::temp_dir("cli_slice");
+  ASSERT_TRUE(write_stl(dir / "c.stl", test::box({0, 0, 0}, {20, 20, 10})));
+  const std::string model = (dir / "c.stl").string(), out = (dir / "c.gcode").string();
+  const CliResult r = run("slice -q " + model + " -o " + out +
+                          " --planar --layer-height 0.25 --temperature 222 --gcode-flavor klipper");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string g = test::read_bytes(out);
+  EXPECT_NE(g.find(";FLAVOR:klipper"), std::string::npos);
+  EXPECT_NE(g.find(";HEIGHT:0.250"), std::string::npos);
+  EXPECT_NE(g.find(";TYPE:External perimeter"), std::string::npos);
+  EXPECT_NE(g.find(";TYPE:Top solid infill"), std::string::npos);
+  EXPECT_EQ(std::count(g.begin(), g.end(), '\n') > 1000, true);
+  // Bad settings and a part larger than the bed: exit 2, one line, no output file.
+  const std::string bad_out = (dir / "bad.gcode").string();
+  for (const std::string args : {" --layer-height -1", " --fill-density 150%", " --set bogus=1",
+                                 " --set bed_shape=0x0,10x0,10x10,0x10", " --temperature nan"}) {
+    const CliResult b = run("slice -q " + model + " -o " + bad_out + " --planar" + args);
+    EXPECT_EQ(b.code, 2) << args << ": " << b.err;
+    EXPECT_EQ(std::count(b.err.begin(), b.err.end(), '\n'), 1) << b.err;
+    EXPECT_FALSE(std::filesystem::exists(bad_out)) << args;
+  }
+  const CliResult bed =
+      run("slice -q " + model + " -o " + bad_out + " --planar --set bed_shape=0x0,10x0,10x10,0x10");
+  EXPECT_NE(bed.err.find("larger than the bed"), std::string::npos) << bed.err;
+  // A profile file, and a broken one naming its line.
+  test::write_bytes(dir / "p.ini", "layer_height = 0.3\ntemperature = 199\n");
+  ASSERT_EQ(
+      run("slice -q " + model + " -o " + out + " --planar --config " + (dir / "p.ini").string())
+          .code,
+      0);
+  EXPECT_NE(test::read_bytes(out).find("M104 S199"), std::string::npos);
+  test::write_bytes(dir / "q.ini", "layer_height = 0.3\nfill_density = much\n");
+  const CliResult q = run("slice -q " + model + " -o " + bad_out + " --planar --config " +
+                          (dir / "q.ini").string());
+  EXPECT_EQ(q.code, 2);
+  EXPECT_NE(q.err.find("q.ini: line 2: fill_density"), std::string::npos) << q.err;
+}
+
 TEST(Cli, HelpAndUsage) {
   const CliResult h = run("analyze --help");
   EXPECT_EQ(h.code, 0);
