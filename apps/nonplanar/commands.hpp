@@ -14,5 +14,7 @@ void register_fit(CLI::App& app, std::function<int()>* run);
 void register_layers(CLI::App& app, std::function<int()>* run);
 /// Adds "slice".
 void register_slice(CLI::App& app, std::function<int()>* run);
+/// Adds "check".
+void register_check(CLI::App& app, std::function<int()>* run);
 
 }  // namespace nonplanar::cli

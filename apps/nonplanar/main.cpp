@@ -20,6 +20,7 @@ int main(int argc, char** argv) {
   register_fit(app, &run);
   register_layers(app, &run);
   register_slice(app, &run);
+  register_check(app, &run);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

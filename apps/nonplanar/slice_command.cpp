@@ -6,6 +6,7 @@
 #include "cli_common.hpp"
 #include "commands.hpp"
 #include "nonplanar/gcode.hpp"
+#include "nonplanar/pipeline.hpp"
 
 namespace nonplanar::cli {
 namespace {
@@ -14,6 +15,7 @@ struct SliceOptions {
   MeshOptions mesh;
   std::string output, config;
   bool planar = false;
+  double max_angle = 30.0;
   // Overrides, applied by key after the profile, in this order.
   std::vector<std::pair<std::string, std::string*>> named;
   std::vector<std::string> sets;
@@ -43,9 +45,6 @@ int run(const SliceOptions& o) {
     if (int rc = apply(kv.substr(0, eq), kv.substr(eq + 1))) return rc;
   }
   if (auto v = validate_config(cfg); !v) return report_error(v.error());
-  if (!o.planar)
-    return report_error({Status::unsupported,
-                         "non-planar slicing is not available yet in this build; pass --planar"});
   if (!o.mesh.quiet)
     for (const auto& n : cfg.notes) std::fprintf(stderr, "warning: %s\n", n.c_str());
 
@@ -62,17 +61,25 @@ int run(const SliceOptions& o) {
                          o.mesh.model + ": part is " + std::to_string(box.size().x()) + " x " +
                              std::to_string(box.size().y()) + " mm, larger than the bed (" +
                              std::to_string(bed.x()) + " x " + std::to_string(bed.y()) + " mm)"});
-  auto layers = slice_mesh(loaded->mesh, cfg.slice, ctx);
-  if (!layers) return finish_progress(), report_error(layers.error());
-  auto paths = make_toolpaths(*layers, cfg.paths, ctx);
-  if (!paths) return finish_progress(), report_error(paths.error());
-  const std::vector<std::string> header = {"mode: planar", "model: " + o.mesh.model};
-  auto w = write_gcode_file(o.output, *paths, cfg, header, ctx);
+  SliceJob job = make_job(cfg, o.max_angle);
+  job.planar_only = o.planar;
+  auto result = slice_model(loaded->mesh, job, ctx);
+  if (!result) return finish_progress(), report_error(result.error());
+  std::vector<std::string> header = result->header;
+  header.push_back("model: " + o.mesh.model);
+  auto w = write_gcode_file(o.output, result->layers, cfg, header, ctx);
   finish_progress();
   if (!w) return report_error(w.error());
   report_warnings(o.mesh.model, *loaded, o.mesh.quiet);
-  if (!o.mesh.quiet)
-    std::fprintf(stderr, "wrote %s: %zu layers\n", o.output.c_str(), paths->size());
+  if (!o.mesh.quiet) {
+    for (const auto& n : result->notices) std::fprintf(stderr, "notice: %s\n", n.c_str());
+    std::fprintf(stderr,
+                 "wrote %s: %zu layers, %zu curved stack%s, layer thickness %.3f-%.3f mm, "
+                 "steepest extrusion %.1f deg, 0 collisions\n",
+                 o.output.c_str(), result->layers.size(), result->plan.stacks.size(),
+                 result->plan.stacks.size() == 1 ? "" : "s", result->thickness_min,
+                 result->thickness_max, result->steepest_deg);
+  }
   return kExitOk;
 }
 
@@ -82,13 +89,18 @@ void register_slice(CLI::App& app, std::function<int()>* run_fn) {
   auto o = std::make_shared<SliceOptions>();
   CLI::App* cmd = app.add_subcommand(
       "slice",
-      "Slice a model into G-code. Defaults print on a generic 0.4 mm nozzle Marlin 2 printer\n"
+      "Slice a model into G-code with curved top layers where the surface allows (see\n"
+      "'layers'), planar elsewhere; --planar slices flat only. Defaults print on a generic\n"
+      "0.4 mm nozzle Marlin 2 printer\n"
       "with a 220 x 220 mm bed; --config loads a JSON profile or a PrusaSlicer .ini, and\n"
       "the options below (or --set KEY=VALUE with any PrusaSlicer key) override it.");
   o->mesh.add_to(*cmd);
   cmd->add_option("-o,--output", o->output, "G-code file to write (atomically)")->required();
   cmd->add_option("--config", o->config, "Profile: .json or PrusaSlicer .ini");
   cmd->add_flag("--planar", o->planar, "Planar layers only (the ordinary slicing engine)");
+  cmd->add_option("--max-angle", o->max_angle,
+                  "Steepest surface printed non-planar, degrees (nozzle geometry)")
+      ->capture_default_str();
   static const char* keys[][2] = {
       {"layer_height", "Layer height (mm)"},
       {"first_layer_height", "First layer height (mm or %)"},

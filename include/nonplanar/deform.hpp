@@ -4,6 +4,7 @@
 
 #include "nonplanar/context.hpp"
 #include "nonplanar/layers.hpp"
+#include "nonplanar/toolpaths.hpp"
 
 namespace nonplanar {
 
@@ -17,6 +18,19 @@ struct NormalizedMesh {
   std::size_t edges_split = 0;
   int rounds = 0;
 };
+
+struct MapBackParams {
+  double tolerance = 0.01;  ///< max distance of a straight segment from its curved layer, mm
+};
+
+/// Maps toolpaths sliced from the normalised mesh back onto the curved layers:
+/// (x, y, ζ) ↦ (x, y, z(x, y, t(ζ))), splitting segments until each stays within the
+/// tolerance of its layer; each point's height becomes the local layer thickness there, so
+/// extrusion follows it. Top skins on a slope are reordered to print from low to high.
+Expected<std::vector<LayerToolpaths>> map_toolpaths_back(const std::vector<LayerToolpaths>& planar,
+                                                         const LayerField& field,
+                                                         const MapBackParams& params,
+                                                         const Context& ctx);
 
 /// Splits every edge whose mapped midpoint is farther than the tolerance from the mapped
 /// chord (conforming: both faces of an edge split it), then maps every vertex. A closed,

@@ -32,6 +32,8 @@ struct ExtrusionPath {
 struct LayerToolpaths {
   double z = 0, height = 0.2;        ///< nominal top of the layer and its thickness
   std::vector<ExtrusionPath> paths;  ///< in print order
+  bool nonplanar = false;            ///< some point leaves the plane z (travels must lift)
+  double max_z = 0;                  ///< highest point of the layer (travel clearance)
 };
 
 /// Builds the paths of every layer from its islands. Errors: invalid_argument, cancelled.

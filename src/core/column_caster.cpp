@@ -30,38 +30,64 @@ ColumnCaster::ColumnCaster(const TriangleMesh& mesh, double cell) : mesh_(mesh),
   }
 }
 
-std::vector<double> ColumnCaster::crossings(double x, double y) const {
-  std::vector<double> z;
-  const int i = static_cast<int>(std::floor((x - origin_.x()) / cell_));
-  const int j = static_cast<int>(std::floor((y - origin_.y()) / cell_));
-  if (i < 0 || j < 0 || i >= nx_ || j >= ny_) return z;
-  for (int f : bins_[static_cast<std::size_t>(i) * ny_ + j]) {
-    const auto& t = mesh_.faces[f];
-    const Vec3 &a = mesh_.vertices[t[0]], &b = mesh_.vertices[t[1]], &c = mesh_.vertices[t[2]];
+namespace {
+
+// (height, +1 entering / −1 leaving) of every face the vertical line at (x, y) meets.
+std::vector<std::pair<double, int>> signed_hits(const TriangleMesh& m,
+                                                const std::vector<int>& faces, double x, double y) {
+  std::vector<std::pair<double, int>> hits;
+  for (int f : faces) {
+    const auto& t = m.faces[f];
+    const Vec3 &a = m.vertices[t[0]], &b = m.vertices[t[1]], &c = m.vertices[t[2]];
     // Barycentric coordinates in XY, with a little slack so a line through a shared edge
-    // or vertex is claimed by every face there (rounding must not drop it); the copies
-    // have the same height and are merged below.
+    // or vertex is claimed by every face there (rounding must not drop it); copies with
+    // the same height and direction are merged below.
     const double d = (b.x() - a.x()) * (c.y() - a.y()) - (c.x() - a.x()) * (b.y() - a.y());
     if (d == 0.0) continue;  // vertical triangle: the line grazes it
     const double l1 = ((x - a.x()) * (c.y() - a.y()) - (c.x() - a.x()) * (y - a.y())) / d;
     const double l2 = ((b.x() - a.x()) * (y - a.y()) - (x - a.x()) * (b.y() - a.y())) / d;
     const double l0 = 1.0 - l1 - l2;
-    auto in = [](double l) { return l >= -1e-12; };
-    if (!(in(l0) && in(l1) && in(l2))) continue;
-    z.push_back(l0 * a.z() + l1 * b.z() + l2 * c.z());
+    if (l0 < -1e-12 || l1 < -1e-12 || l2 < -1e-12) continue;
+    hits.emplace_back(l0 * a.z() + l1 * b.z() + l2 * c.z(), d > 0 ? -1 : +1);  // d > 0: normal up
   }
-  std::sort(z.begin(), z.end());
-  // Merge crossings at the same height (a line through a shared edge hits both faces).
-  z.erase(
-      std::unique(z.begin(), z.end(), [](double p, double q) { return std::abs(p - q) < 1e-9; }),
-      z.end());
+  // Entering before leaving at equal heights, so touching shells stay one interval.
+  std::sort(hits.begin(), hits.end(), [](const auto& p, const auto& q) {
+    return p.first < q.first - 1e-9 || (std::abs(p.first - q.first) <= 1e-9 && p.second > q.second);
+  });
+  hits.erase(std::unique(hits.begin(), hits.end(),
+                         [](const auto& p, const auto& q) {
+                           return std::abs(p.first - q.first) < 1e-9 && p.second == q.second;
+                         }),
+             hits.end());
+  return hits;
+}
+
+}  // namespace
+
+std::vector<double> ColumnCaster::crossings(double x, double y) const {
+  std::vector<double> z;
+  const int i = static_cast<int>(std::floor((x - origin_.x()) / cell_));
+  const int j = static_cast<int>(std::floor((y - origin_.y()) / cell_));
+  if (i < 0 || j < 0 || i >= nx_ || j >= ny_) return z;
+  for (const auto& h : signed_hits(mesh_, bins_[static_cast<std::size_t>(i) * ny_ + j], x, y))
+    z.push_back(h.first);
   return z;
 }
 
 std::vector<std::pair<double, double>> ColumnCaster::intervals(double x, double y) const {
-  const std::vector<double> z = crossings(x, y);
   std::vector<std::pair<double, double>> out;
-  for (std::size_t k = 0; k + 1 < z.size(); k += 2) out.emplace_back(z[k], z[k + 1]);
+  const int i = static_cast<int>(std::floor((x - origin_.x()) / cell_));
+  const int j = static_cast<int>(std::floor((y - origin_.y()) / cell_));
+  if (i < 0 || j < 0 || i >= nx_ || j >= ny_) return out;
+  int winding = 0;
+  double start = 0;
+  for (const auto& [z, s] :
+       signed_hits(mesh_, bins_[static_cast<std::size_t>(i) * ny_ + j], x, y)) {
+    const int before = winding;
+    winding += s;
+    if (before <= 0 && winding > 0) start = z;
+    if (before > 0 && winding <= 0) out.emplace_back(start, z);
+  }
   return out;
 }
 

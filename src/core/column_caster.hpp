@@ -14,7 +14,8 @@ class ColumnCaster {
   explicit ColumnCaster(const TriangleMesh& mesh, double cell = 2.0);
   /// Heights where the vertical line at (x, y) crosses the surface, sorted.
   std::vector<double> crossings(double x, double y) const;
-  /// Material intervals [z_lo, z_hi] along the line (crossings taken in pairs).
+  /// Material intervals [z_lo, z_hi] along the line, by winding number (a face whose normal
+  /// points down enters material, up leaves it), so touching or overlapping shells merge.
   std::vector<std::pair<double, double>> intervals(double x, double y) const;
   /// Is (x, y, z) inside the material?
   bool inside(double x, double y, double z) const;

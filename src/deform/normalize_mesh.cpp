@@ -40,7 +40,10 @@ Expected<NormalizedMesh> normalize_mesh(const TriangleMesh& mesh, const LayerFie
         if (mid.count(key)) continue;
         const Vec3 pm = 0.5 * (m.vertices[a] + m.vertices[b]);
         const Vec3 im = mapped(field, pm);
-        if ((im - 0.5 * (image[a] + image[b])).norm() <= params.tolerance) {
+        // Long edges in a curved region are split regardless: a midpoint on the chord does
+        // not prove the whole edge maps straight.
+        const bool long_curved = im.z() != pm.z() && (m.vertices[a] - m.vertices[b]).norm() > 2.0;
+        if (!long_curved && (im - 0.5 * (image[a] + image[b])).norm() <= params.tolerance) {
           mid.emplace(key, -1);
           continue;
         }

@@ -97,7 +97,22 @@ class Emitter {
     retracted_ = false;
   }
   // Travel to p: lift and retract for long moves, never through the part at print height.
-  void travel(const Vec3& p, double speed) {
+  // On a curved layer, material printed so far lies below the layer's highest point, so a
+  // travel rises above that (plus a clearance), moves, then descends.
+  void travel(const Vec3& p, double speed, bool curved, double safe_z) {
+    if (curved && have_pos_) {
+      const double d = (p.head<2>() - pos_.head<2>()).norm();
+      if (d < 1e-6 && std::abs(p.z() - pos_.z()) < 1e-6) return;
+      if (d > 0.6 || std::abs(p.z() - pos_.z()) > 0.1) {
+        if (d > g_.retract_before_travel) retract();
+        const double lift = std::max({safe_z, pos_.z(), p.z()}) + std::max(0.3, g_.retract_lift);
+        line("G1 Z%.3f F%d", lift, static_cast<int>(speed * 60));
+        line("G1 X%.3f Y%.3f F%d", p.x(), p.y(), static_cast<int>(speed * 60));
+        line("G1 Z%.3f F%d", p.z(), static_cast<int>(speed * 60));
+        pos_ = p;
+        return;
+      }
+    }
     const double d = (p.head<2>() - pos_.head<2>()).norm();
     if (!have_pos_) {
       // Wherever the start G-code left the nozzle, the way to the print is long: retract.
@@ -183,7 +198,7 @@ Expected<std::string> make_gcode(const std::vector<LayerToolpaths>& layers, cons
     bool first = true;
     for (const ExtrusionPath& p : L.paths) {
       if (p.points.size() < 2) continue;
-      em.travel(p.points.front(), c.paths.travel_speed);
+      em.travel(p.points.front(), c.paths.travel_speed, L.nonplanar, L.max_z);
       if (first || p.role != role) em.line(";TYPE:%s", role_name(p.role));
       if (first || std::abs(p.width - width) > 1e-9) em.line(";WIDTH:%.3f", p.width);
       first = false;

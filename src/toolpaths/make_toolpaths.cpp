@@ -90,6 +90,7 @@ Expected<std::vector<LayerToolpaths>> make_toolpaths(const std::vector<SlicedLay
     LayerToolpaths& T = out[i];
     T.z = z;
     T.height = h;
+    T.max_z = z;
     // Skins: solid where there is air within top_solid_layers above or bottom_solid_layers
     // below; "top" where the very next layer does not cover it.
     const ExPolygons& fill = reg[i].fill;

@@ -1,0 +1,104 @@
+// `nonplanar check`: the quality figures of DESIGN.md §4 from a G-code file (ours or
+// PrusaSlicer's) and the mesh it was sliced from.
+#include <cstdio>
+#include <memory>
+#include <nlohmann/json.hpp>
+
+#include "cli_common.hpp"
+#include "commands.hpp"
+#include "io/mesh_buffer.hpp"
+#include "nonplanar/check.hpp"
+
+namespace nonplanar::cli {
+namespace {
+
+struct CheckOptions {
+  MeshOptions mesh;
+  std::string gcode, config;
+  CheckParams params;
+  bool json = false;
+};
+
+int run(CheckOptions o) {
+  PrintConfig cfg;
+  if (!o.config.empty()) {
+    auto c = load_config(o.config);
+    if (!c) return report_error(c.error());
+    cfg = std::move(*c);
+    o.params.filament_diameter = cfg.gcode.filament_diameter;
+    o.params.layer_height = cfg.slice.layer_height;
+  }
+  Context ctx = make_context(o.mesh.quiet || o.json);
+  auto bytes = io::read_file_bytes(o.gcode, 2ull << 30);
+  if (!bytes)
+    return finish_progress(),
+           report_error({bytes.error().status, o.gcode + ": " + bytes.error().message});
+  auto moves = read_gcode_moves(bytes->view());
+  if (!moves)
+    return finish_progress(),
+           report_error({moves.error().status, o.gcode + ": " + moves.error().message});
+  LoadParams lp = o.mesh.load;
+  lp.bed_center = cfg.bed_center();
+  auto mesh = load_mesh(o.mesh.model, lp, ctx);
+  if (!mesh) return finish_progress(), report_error(mesh.error());
+  auto f = check_print(*moves, &mesh->mesh, o.params, ctx);
+  finish_progress();
+  if (!f) return report_error(f.error());
+  if (o.json) {
+    nlohmann::ordered_json j = {{"gcode", o.gcode},
+                                {"mesh", o.mesh.model},
+                                {"top_surface_deviation",
+                                 {{"mean", f->deviation_mean},
+                                  {"p95", f->deviation_p95},
+                                  {"max", f->deviation_max},
+                                  {"samples", f->surface_samples},
+                                  {"covered_samples", f->covered_samples}}},
+                                {"thickness_min", f->thickness_min},
+                                {"thickness_max", f->thickness_max},
+                                {"steepest_extrusion", f->steepest_deg},
+                                {"collisions", f->collisions},
+                                {"volume_ratio", f->volume_ratio},
+                                {"outside_fraction", f->outside_fraction},
+                                {"extrusion_points", f->extrusions}};
+    std::printf("%s\n", j.dump(2).c_str());
+    return kExitOk;
+  }
+  std::printf("%s against %s\n", o.gcode.c_str(), o.mesh.model.c_str());
+  std::printf(
+      "  top-surface deviation   mean %.4f  p95 %.4f  max %.4f mm  (%zu of %zu samples covered)\n",
+      f->deviation_mean, f->deviation_p95, f->deviation_max, f->covered_samples,
+      f->surface_samples);
+  std::printf("  layer thickness         %.3f - %.3f mm\n", f->thickness_min, f->thickness_max);
+  std::printf("  steepest extrusion      %.1f deg\n", f->steepest_deg);
+  std::printf("  collisions              %zu\n", f->collisions);
+  std::printf("  extruded / mesh volume  %.3f\n", f->volume_ratio);
+  std::printf("  extrusion outside mesh  %.2f %%\n", 100 * f->outside_fraction);
+  return kExitOk;
+}
+
+}  // namespace
+
+void register_check(CLI::App& app, std::function<int()>* run_fn) {
+  auto o = std::make_shared<CheckOptions>();
+  CLI::App* cmd = app.add_subcommand(
+      "check",
+      "Recompute the quality figures of a G-code file against its mesh (placed as PrusaSlicer\n"
+      "places it: XY centre at the bed centre, lowest point at z = 0): top-surface deviation,\n"
+      "layer thickness, steepest extrusion, collisions, volume ratio, extrusion outside the\n"
+      "mesh. Works on PrusaSlicer's G-code too. See docs/check.md for how each is computed.");
+  cmd->add_option("gcode", o->gcode, "G-code file")->required();
+  cmd->add_option("--mesh", o->mesh.model, "The mesh it was sliced from")->required();
+  cmd->add_option("--config", o->config, "Profile (bed size, filament, layer height)");
+  cmd->add_option("--scale", o->mesh.load.scale, "Scale applied when slicing");
+  cmd->add_option("--max-angle", o->params.max_angle_deg, "Printable facet slope (deg)")
+      ->capture_default_str();
+  cmd->add_option("--nozzle-tip-radius", o->params.nozzle_tip_radius, "mm")->capture_default_str();
+  cmd->add_option("--block-radius", o->params.block_radius, "mm")->capture_default_str();
+  cmd->add_option("--block-clearance", o->params.block_clearance, "mm")->capture_default_str();
+  cmd->add_flag("--json", o->json, "Print one JSON document");
+  cmd->add_flag("-q,--quiet", o->mesh.quiet, "No progress on stderr");
+  *run_fn = nullptr;
+  cmd->callback([o, run_fn] { *run_fn = [o] { return run(*o); }; });
+}
+
+}  // namespace nonplanar::cli

@@ -1,0 +1,67 @@
+// Stage check (DESIGN.md §3–4): an independent validator of a print. It reads G-code (ours or
+// PrusaSlicer's / OrcaSlicer's) into moves and recomputes every quality figure from them.
+#pragma once
+
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "nonplanar/config.hpp"
+#include "nonplanar/context.hpp"
+#include "nonplanar/toolpaths.hpp"
+
+namespace nonplanar {
+
+/// One G0/G1 move with what it deposited.
+struct PrintMove {
+  Vec3 from{0, 0, 0}, to{0, 0, 0};
+  double filament = 0;     ///< mm of filament pushed (negative: retraction)
+  bool extruding = false;  ///< filament > 0 and the nozzle moved in XY
+  std::string type;        ///< the ;TYPE: in force ("" before any)
+  int layer = -1;          ///< ;LAYER_CHANGE count − 1
+  double width = 0.45;     ///< ;WIDTH: in force
+  int line = 0;            ///< 1-based line in the file (0 for moves made in memory)
+};
+
+/// Reads G-code strictly: G0/G1 (X Y Z E F), G92, G90/G91, M82/M83, the comments ;TYPE:,
+/// ;WIDTH:, ;LAYER_CHANGE; other M-codes and motionless G-codes (G4, G10/G11, G21, G28, G29,
+/// G80) pass. Arcs (G2/G3), inches (G20) and unknown G-codes are errors naming the line.
+Expected<std::vector<PrintMove>> read_gcode_moves(std::string_view text);
+
+/// The same moves straight from toolpaths (for the check before a file is written).
+std::vector<PrintMove> moves_from_toolpaths(const std::vector<LayerToolpaths>& layers,
+                                            const GcodeParams& g);
+
+/// Printer geometry and limits used by the figures. mm, degrees.
+struct CheckParams {
+  double max_angle_deg = 30;
+  double layer_height = 0.2;  ///< h: a collision is a penetration deeper than h / 2
+  double nozzle_tip_radius = 0.4;
+  double nozzle_angle_deg = 45;
+  double block_radius = 8, block_clearance = 4;
+  double filament_diameter = 1.75;
+  double surface_samples_per_mm2 = 2;
+};
+
+/// The figures of DESIGN.md §4. Deviation is vertical, mm; thickness is the height of each
+/// extrusion above the previous layer's extrusions there (least-squares plane within
+/// 0.6 mm); angles in degrees.
+struct CheckFigures {
+  std::size_t surface_samples = 0, covered_samples = 0;
+  double deviation_mean = 0, deviation_p95 = 0, deviation_max = 0;
+  double thickness_min = 0, thickness_max = 0;
+  double steepest_deg = 0;
+  std::size_t collisions = 0;
+  Vec3 first_collision{0, 0, 0};
+  int first_collision_line = 0;
+  double volume_ratio = 0;      ///< extruded volume (skirt excluded) / mesh volume
+  double outside_fraction = 0;  ///< extrusion points outside the mesh (skirt excluded)
+  std::size_t extrusions = 0;
+};
+
+/// Computes the figures; `mesh` (placed like the G-code) may be null, then deviation,
+/// volume ratio and outside fraction are left at 0. Errors: cancelled.
+Expected<CheckFigures> check_print(const std::vector<PrintMove>& moves, const TriangleMesh* mesh,
+                                   const CheckParams& params, const Context& ctx);
+
+}  // namespace nonplanar

@@ -1,0 +1,39 @@
+// The whole non-planar pipeline of DESIGN.md §2 as one call: analysis → fit → layers →
+// normalisation → planar slicing → toolpaths → mapping back → safety check.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "nonplanar/check.hpp"
+#include "nonplanar/layers.hpp"
+
+namespace nonplanar {
+
+struct SliceJob {
+  AnalysisParams analysis;
+  FitParams fit;
+  LayerParams layers;  ///< layer heights and printer limits; set from print by make_job
+  PrintConfig print;
+  bool planar_only = false;
+};
+
+/// A job whose layer and check settings agree with the print configuration.
+SliceJob make_job(const PrintConfig& print, double max_angle_deg = 30.0);
+
+struct SliceResult {
+  std::vector<LayerToolpaths> layers;
+  LayerPlan plan;
+  std::vector<std::string> notices;  ///< one line each (fallbacks, planar because ...)
+  std::vector<std::string> header;   ///< for the G-code's header comment
+  double thickness_min = 0, thickness_max = 0, steepest_deg = 0;
+  std::size_t collisions = 0;
+  bool nonplanar = false;
+};
+
+/// Runs the pipeline on a mesh already placed on the bed. A violation of the printer limits
+/// in the final paths is an internal_error naming where (no G-code should be written then).
+Expected<SliceResult> slice_model(const TriangleMesh& mesh, const SliceJob& job,
+                                  const Context& ctx);
+
+}  // namespace nonplanar

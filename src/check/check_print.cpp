@@ -1,0 +1,270 @@
+// The quality figures of DESIGN.md §4, from moves alone.
+//
+// Notation: an extrusion point is a sample along an extruding move (every ≤ 0.3 mm) with its
+// layer; E_L(x, y) is layer L's extrusion height near (x, y), the least-squares plane
+// through its points within 0.6 mm. Collision model (§3): nozzle tip radius r, wall angle α,
+// block radius R and clearance H; earlier layers' material at q penetrates the nozzle at p by
+// z(q) − z(p) − max(0, |q − p| − r)·tan α (cone) or z(q) − z(p) − H (block).
+#include <algorithm>
+#include <cmath>
+#include <unordered_map>
+
+#include <Eigen/Eigenvalues>
+
+#include "core/column_caster.hpp"
+#include "nonplanar/check.hpp"
+
+namespace nonplanar {
+namespace {
+
+constexpr double kNear = 0.6;  // neighbourhood for plane fits, mm
+
+struct Pt {
+  Vec3 p;
+  int layer;
+};
+
+// Extrusion points binned on an XY grid of kNear cells.
+class PointGrid {
+ public:
+  void add(const Pt& q) { cells_[key(q.p.x(), q.p.y())].push_back(q); }
+  template <class F>
+  void near(double x, double y, F&& f) const {
+    const long i = static_cast<long>(std::floor(x / kNear)),
+               j = static_cast<long>(std::floor(y / kNear));
+    for (long a = i - 1; a <= i + 1; ++a)
+      for (long b = j - 1; b <= j + 1; ++b) {
+        const auto it = cells_.find(pack(a, b));
+        if (it == cells_.end()) continue;
+        for (const Pt& q : it->second) f(q);
+      }
+  }
+
+ private:
+  static long long pack(long a, long b) {
+    return (static_cast<long long>(a) << 32) ^ (b & 0xffffffffLL);
+  }
+  static long long key(double x, double y) {
+    return pack(static_cast<long>(std::floor(x / kNear)), static_cast<long>(std::floor(y / kNear)));
+  }
+  std::unordered_map<long long, std::vector<Pt>> cells_;
+};
+
+// z of the least-squares plane through points of `layer` within kNear of (x, y). Points
+// along one line do not define a plane (a fit would extrapolate across it): then the
+// nearest point's height is used.
+bool plane_z(const PointGrid& g, int layer, double x, double y, double* z) {
+  Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d b = Eigen::Vector3d::Zero();
+  int n = 0;
+  double nearest = 1e300, z_near = 0;
+  g.near(x, y, [&](const Pt& q) {
+    if (q.layer != layer) return;
+    const double dx = q.p.x() - x, dy = q.p.y() - y, d2 = dx * dx + dy * dy;
+    if (d2 > kNear * kNear) return;
+    const Eigen::Vector3d r(1, dx, dy);
+    A += r * r.transpose();
+    b += r * q.p.z();
+    if (d2 < nearest) nearest = d2, z_near = q.p.z();
+    ++n;
+  });
+  if (n == 0) return false;
+  *z = z_near;
+  if (n < 3) return nearest <= 0.2 * 0.2;
+  // Spread of the points in XY: the smallest eigenvalue of their covariance.
+  const double mx = A(0, 1) / n, my = A(0, 2) / n;
+  Eigen::Matrix2d cov;
+  cov << A(1, 1) / n - mx * mx, A(1, 2) / n - mx * my, A(1, 2) / n - mx * my, A(2, 2) / n - my * my;
+  if (Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(cov).eigenvalues()[0] < 0.05 * 0.05)
+    return nearest <= 0.2 * 0.2;  // a slope makes a farther point's height misleading
+  *z = A.ldlt().solve(b)[0];
+  return true;
+}
+
+// Heights of deposited material per cell, split into "earlier layers" and "this layer",
+// with coarse block maxima to skip cells that cannot collide.
+class Deposit {
+ public:
+  Deposit(const Vec2& lo, const Vec2& hi, double cell) : lo_(lo), cell_(cell) {
+    nx_ = static_cast<int>((hi.x() - lo.x()) / cell) + 2;
+    ny_ = static_cast<int>((hi.y() - lo.y()) / cell) + 2;
+    cells_.assign(static_cast<std::size_t>(nx_) * ny_, Cell{});
+    bx_ = nx_ / kBlock + 1, by_ = ny_ / kBlock + 1;
+    block_.assign(static_cast<std::size_t>(bx_) * by_, -1e300);
+  }
+  void put(const Vec3& p, int layer) {
+    const int i = ix(p.x()), j = iy(p.y());
+    if (i < 0 || j < 0 || i >= nx_ || j >= ny_) return;
+    Cell& c = cells_[static_cast<std::size_t>(i) * ny_ + j];
+    if (c.layer < layer)
+      c.earlier = std::max(c.earlier, c.current), c.current = -1e300, c.layer = layer;
+    c.current = std::max(c.current, p.z());
+    double& b = block_[static_cast<std::size_t>(i / kBlock) * by_ + j / kBlock];
+    b = std::max(b, p.z());
+  }
+  // Does earlier layers' material enter the nozzle at p deeper than `depth`? A block is
+  // skipped unless its highest point clears the smallest allowance anywhere in it (the cone
+  // at the block's nearest distance, or the heater block).
+  bool collides(const Vec3& p, int layer, const CheckParams& cp, double tan_a, double depth) const {
+    const double R = cp.block_radius, R2 = R * R;
+    const int i0 = ix(p.x() - R), i1 = ix(p.x() + R), j0 = iy(p.y() - R), j1 = iy(p.y() + R);
+    for (int bi = std::max(0, i0 / kBlock); bi <= std::min(bx_ - 1, i1 / kBlock); ++bi)
+      for (int bj = std::max(0, j0 / kBlock); bj <= std::min(by_ - 1, j1 / kBlock); ++bj) {
+        const double bx0 = lo_.x() + bi * kBlock * cell_, by0 = lo_.y() + bj * kBlock * cell_;
+        const double dx = std::max({bx0 - p.x(), 0.0, p.x() - (bx0 + kBlock * cell_)});
+        const double dy = std::max({by0 - p.y(), 0.0, p.y() - (by0 + kBlock * cell_)});
+        const double dmin = std::sqrt(dx * dx + dy * dy);
+        if (dmin > R) continue;
+        const double allow =
+            std::min(std::max(0.0, dmin - cp.nozzle_tip_radius) * tan_a, cp.block_clearance);
+        if (block_[static_cast<std::size_t>(bi) * by_ + bj] <= p.z() + depth + allow) continue;
+        for (int i = std::max(i0, bi * kBlock); i <= std::min(i1, bi * kBlock + kBlock - 1); ++i)
+          for (int j = std::max(j0, bj * kBlock); j <= std::min(j1, bj * kBlock + kBlock - 1);
+               ++j) {
+            if (i < 0 || j < 0 || i >= nx_ || j >= ny_) continue;
+            const Cell& c = cells_[static_cast<std::size_t>(i) * ny_ + j];
+            const double z = c.layer < layer ? std::max(c.earlier, c.current) : c.earlier;
+            if (z <= p.z() + depth) continue;
+            const double ex = lo_.x() + (i + 0.5) * cell_ - p.x(),
+                         ey = lo_.y() + (j + 0.5) * cell_ - p.y();
+            const double d2 = ex * ex + ey * ey;
+            if (d2 > R2) continue;
+            const double cone = std::max(0.0, std::sqrt(d2) - cp.nozzle_tip_radius) * tan_a;
+            if (z - p.z() - std::min(cone, cp.block_clearance) > depth) return true;
+          }
+      }
+    return false;
+  }
+
+ private:
+  static constexpr int kBlock = 16;
+  struct Cell {
+    double earlier = -1e300, current = -1e300;
+    int layer = -1;
+  };
+  int ix(double x) const { return static_cast<int>(std::floor((x - lo_.x()) / cell_)); }
+  int iy(double y) const { return static_cast<int>(std::floor((y - lo_.y()) / cell_)); }
+  Vec2 lo_;
+  double cell_;
+  int nx_ = 0, ny_ = 0, bx_ = 0, by_ = 0;
+  std::vector<Cell> cells_;
+  std::vector<double> block_;
+};
+
+}  // namespace
+
+Expected<CheckFigures> check_print(const std::vector<PrintMove>& moves, const TriangleMesh* mesh,
+                                   const CheckParams& cp, const Context& ctx) {
+  CheckFigures f;
+  const double tan_a = std::tan(cp.nozzle_angle_deg * M_PI / 180.0);
+  auto counts = [](const PrintMove& m) {
+    return m.extruding && m.layer >= 0 && m.type != "Skirt/Brim";
+  };
+  // Extrusion points and extents.
+  PointGrid grid;
+  std::vector<Pt> pts;
+  Vec2 lo(1e300, 1e300), hi(-1e300, -1e300);
+  double filament = 0;
+  for (const PrintMove& m : moves) {
+    if (!counts(m)) continue;
+    filament += m.filament;
+    const double len = (m.to - m.from).norm();
+    // Every 0.2 mm: the coverage test below allows half of that beyond half a line width.
+    const int n = std::max(1, static_cast<int>(std::ceil(len / 0.2)));
+    for (int k = 1; k <= n; ++k) {
+      const Pt q{m.from + (m.to - m.from) * (static_cast<double>(k) / n), m.layer};
+      pts.push_back(q);
+      grid.add(q);
+      lo = lo.cwiseMin(q.p.head<2>()), hi = hi.cwiseMax(q.p.head<2>());
+    }
+    const double dxy = (m.to.head<2>() - m.from.head<2>()).norm();
+    if (dxy > 0.05)
+      f.steepest_deg =
+          std::max(f.steepest_deg, std::atan2(std::abs(m.to.z() - m.from.z()), dxy) * 180 / M_PI);
+  }
+  f.extrusions = pts.size();
+  if (pts.empty()) return f;
+  if (ctx.cancelled()) return Error{Status::cancelled, "cancelled"};
+
+  // Thickness: height above the previous layer's extrusions there (first layer: the bed).
+  f.thickness_min = 1e300, f.thickness_max = 0;
+  for (std::size_t k = 0; k < pts.size(); k += 3) {
+    const Pt& q = pts[k];
+    double below = 0;
+    if (q.layer > 0 && !plane_z(grid, q.layer - 1, q.p.x(), q.p.y(), &below)) continue;  // bridge
+    const double t = q.p.z() - below;
+    f.thickness_min = std::min(f.thickness_min, t);
+    f.thickness_max = std::max(f.thickness_max, t);
+  }
+  if (f.thickness_min > f.thickness_max) f.thickness_min = f.thickness_max = 0;
+  ctx.progress("check", 0.3);
+
+  // Collisions, in print order.
+  Deposit dep(lo - Vec2(cp.block_radius + 1, cp.block_radius + 1),
+              hi + Vec2(cp.block_radius + 1, cp.block_radius + 1), 0.2);
+  for (const PrintMove& m : moves) {
+    if (!m.extruding || m.layer < 0) continue;
+    const double len = (m.to - m.from).norm();
+    const int n = std::max(1, static_cast<int>(std::ceil(len / 0.2)));
+    for (int k = 1; k <= n; ++k) {
+      const Vec3 p = m.from + (m.to - m.from) * (static_cast<double>(k) / n);
+      if (dep.collides(p, m.layer, cp, tan_a, 0.5 * cp.layer_height)) {
+        if (f.collisions == 0) f.first_collision = p, f.first_collision_line = m.line;
+        ++f.collisions;
+      }
+      dep.put(p, m.layer);
+    }
+  }
+  ctx.progress("check", 0.6);
+  if (!mesh) return f;
+
+  // Volume and extrusion outside the mesh.
+  f.volume_ratio = filament * M_PI * 0.25 * cp.filament_diameter * cp.filament_diameter /
+                   std::max(signed_volume(*mesh), 1e-12);
+  const ColumnCaster cols(*mesh);
+  std::size_t outside = 0, tested = 0;
+  for (std::size_t k = 0; k < pts.size(); k += 2) {
+    ++tested;
+    // The bead lies under the nozzle: test a quarter layer below the nozzle tip.
+    if (!cols.inside(pts[k].p.x(), pts[k].p.y(), pts[k].p.z() - 0.25 * cp.layer_height)) ++outside;
+  }
+  f.outside_fraction = tested ? static_cast<double>(outside) / static_cast<double>(tested) : 0.0;
+
+  // Top-surface deviation on printable up-facing facets.
+  std::vector<double> dev;
+  const double cos_max = std::cos(cp.max_angle_deg * M_PI / 180.0);
+  for (const auto& t : mesh->faces) {
+    const Vec3 &a = mesh->vertices[t[0]], &b = mesh->vertices[t[1]], &c = mesh->vertices[t[2]];
+    const Vec3 nrm = (b - a).cross(c - a);
+    const double area = 0.5 * nrm.norm();
+    if (area <= 0 || nrm.z() / nrm.norm() <= cos_max) continue;
+    const int m = std::max(1, static_cast<int>(std::floor(
+                                  (std::sqrt(8 * cp.surface_samples_per_mm2 * area + 1) - 1) / 2)));
+    for (int i = 0; i < m; ++i)
+      for (int j = 0; i + j < m; ++j) {
+        const Vec3 s = a + (i + 1.0 / 3.0) / m * (b - a) + (j + 1.0 / 3.0) / m * (c - a);
+        ++f.surface_samples;
+        // The highest layer whose extrusion covers this XY within half a line width.
+        int top = -1;
+        grid.near(s.x(), s.y(), [&](const Pt& q) {
+          if ((q.p.head<2>() - s.head<2>()).norm() <= 0.225 + 0.1 && q.layer > top) top = q.layer;
+        });
+        double z = 0;
+        if (top < 0 || !plane_z(grid, top, s.x(), s.y(), &z)) continue;
+        ++f.covered_samples;
+        dev.push_back(std::abs(z - s.z()));
+      }
+  }
+  if (!dev.empty()) {
+    std::sort(dev.begin(), dev.end());
+    double sum = 0;
+    for (double d : dev) sum += d;
+    f.deviation_mean = sum / static_cast<double>(dev.size());
+    f.deviation_p95 = dev[static_cast<std::size_t>(0.95 * static_cast<double>(dev.size() - 1))];
+    f.deviation_max = dev.back();
+  }
+  ctx.progress("check", 1.0);
+  return f;
+}
+
+}  // namespace nonplanar

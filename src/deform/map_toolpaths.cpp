@@ -1,0 +1,120 @@
+// Inverse of the normalisation for toolpaths (DESIGN.md §2 step 6).
+//
+// Notation: a planar point (x, y, ζ) lies on layer boundary t = t(ζ); its real height is
+// z = z(x, y, t) and the layer under it spans t − Δt … t with Δt = t(ζ) − t(ζ − h).
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+
+#include "nonplanar/deform.hpp"
+
+namespace nonplanar {
+namespace {
+
+struct Mapped {
+  Vec3 p;
+  double height;
+};
+
+Mapped map_point(const LayerField& f, const Vec3& q, double h_planar) {
+  if (f.planar_at(q.x(), q.y())) return {q, h_planar};
+  const double t = f.t_of_zeta(q.z()), t0 = f.t_of_zeta(q.z() - h_planar);
+  const double z = f.z_at(q.x(), q.y(), t), z0 = f.z_at(q.x(), q.y(), t0);
+  return {{q.x(), q.y(), z}, z - z0};
+}
+
+// Appends the mapped segment a → b (a already emitted), splitting at midpoints while the
+// mapped midpoint is farther than tol from the chord.
+void emit(const LayerField& f, const Vec3& a, const Mapped& ma, const Vec3& b, const Mapped& mb,
+          double h, double tol, int depth, ExtrusionPath& out) {
+  const Vec3 mid = 0.5 * (a + b);
+  const Mapped mm = map_point(f, mid, h);
+  // A midpoint on the chord proves nothing over a long segment (a symmetric wave passes the
+  // test): in curved regions segments are first cut to at most 1 mm.
+  const double len = (b - a).norm();
+  const bool curved = mm.p.z() != mid.z() || ma.p.z() != a.z() || mb.p.z() != b.z();
+  if (depth < 16 && len > 0.02 &&
+      ((curved && len > 1.0) || (mm.p - 0.5 * (ma.p + mb.p)).norm() > tol)) {
+    emit(f, a, ma, mid, mm, h, tol, depth + 1, out);
+    emit(f, mid, mm, b, mb, h, tol, depth + 1, out);
+    return;
+  }
+  out.points.push_back(mb.p);
+  out.height.push_back(mb.height);
+}
+
+bool is_top(const ExtrusionPath& p) {
+  return p.role == ExtrusionRole::top_solid_infill;
+}
+
+}  // namespace
+
+Expected<std::vector<LayerToolpaths>> map_toolpaths_back(const std::vector<LayerToolpaths>& planar,
+                                                         const LayerField& field,
+                                                         const MapBackParams& params,
+                                                         const Context& ctx) {
+  if (!(params.tolerance > 0)) return Error{Status::invalid_argument, "map tolerance: must be > 0"};
+  std::vector<LayerToolpaths> out(planar.size());
+  std::atomic<bool> stop{false};
+  tbb::parallel_for(std::size_t{0}, planar.size(), [&](std::size_t li) {
+    if (stop || ctx.cancelled()) return stop = true, void();
+    const LayerToolpaths& L = planar[li];
+    LayerToolpaths& M = out[li];
+    M.z = L.z;
+    M.height = L.height;
+    M.max_z = -1e300;
+    double min_z = 1e300;
+    for (const ExtrusionPath& p : L.paths) {
+      ExtrusionPath q;
+      q.role = p.role, q.width = p.width, q.speed = p.speed;
+      if (p.points.empty()) continue;
+      Mapped prev = map_point(field, p.points[0], p.height[0]);
+      q.points.push_back(prev.p);
+      q.height.push_back(prev.height);
+      for (std::size_t k = 1; k < p.points.size(); ++k) {
+        const Mapped cur = map_point(field, p.points[k], p.height[k]);
+        emit(field, p.points[k - 1], prev, p.points[k], cur, p.height[k], params.tolerance, 0, q);
+        prev = cur;
+      }
+      for (const Vec3& v : q.points)
+        M.max_z = std::max(M.max_z, v.z()), min_z = std::min(min_z, v.z());
+      M.paths.push_back(std::move(q));
+    }
+    M.nonplanar = M.max_z - min_z > 1e-6;
+    if (M.paths.empty()) M.max_z = L.z;
+    // Top skins on a slope, low to high: a line printed beside a higher line of the same
+    // layer would drag the nozzle's flat through it (DESIGN.md §3). Each run of top-skin
+    // lines is sorted by height and every line starts at its low end.
+    if (M.nonplanar) {
+      auto& ps = M.paths;
+      for (std::size_t s = 0; s < ps.size();) {
+        if (!is_top(ps[s])) {
+          ++s;
+          continue;
+        }
+        std::size_t e = s;
+        while (e < ps.size() && is_top(ps[e])) ++e;
+        for (std::size_t k = s; k < e; ++k)
+          if (ps[k].points.front().z() > ps[k].points.back().z()) {
+            std::reverse(ps[k].points.begin(), ps[k].points.end());
+            std::reverse(ps[k].height.begin(), ps[k].height.end());
+          }
+        auto mean_z = [](const ExtrusionPath& p) {
+          double z = 0;
+          for (const Vec3& v : p.points) z += v.z();
+          return z / static_cast<double>(p.points.size());
+        };
+        std::stable_sort(
+            ps.begin() + static_cast<long>(s), ps.begin() + static_cast<long>(e),
+            [&](const ExtrusionPath& a, const ExtrusionPath& b) { return mean_z(a) < mean_z(b); });
+        s = e;
+      }
+    }
+  });
+  if (stop) return Error{Status::cancelled, "cancelled"};
+  return out;
+}
+
+}  // namespace nonplanar

@@ -1,0 +1,123 @@
+// The whole pipeline on analytic solids: figures that must hold (issue: end-to-end).
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "nonplanar/gcode.hpp"
+#include "nonplanar/pipeline.hpp"
+#include "support/solids.hpp"
+
+namespace nonplanar {
+namespace {
+
+TriangleMesh placed(TriangleMesh m, const PrintConfig& c) {
+  const BoundingBox b = bounding_box(m);
+  const Vec3 shift(c.bed_center().x() - 0.5 * (b.min.x() + b.max.x()),
+                   c.bed_center().y() - 0.5 * (b.min.y() + b.max.y()), -b.min.z());
+  for (Vec3& v : m.vertices) v += shift;
+  return m;
+}
+
+struct Outcome {
+  SliceResult result;
+  CheckFigures figures;
+  std::string gcode;
+};
+
+Outcome run(const TriangleMesh& raw, PrintConfig c = {}) {
+  const TriangleMesh mesh = placed(raw, c);
+  auto r = slice_model(mesh, make_job(c), {});
+  EXPECT_TRUE(r) << r.error().message;
+  auto text = make_gcode(r->layers, c, r->header, {});
+  EXPECT_TRUE(text);
+  auto moves = read_gcode_moves(*text);  // strict: any unknown command fails
+  EXPECT_TRUE(moves) << moves.error().message;
+  CheckParams cp;
+  auto f = check_print(*moves, &mesh, cp, {});
+  EXPECT_TRUE(f);
+  return {std::move(*r), *f, std::move(*text)};
+}
+
+void expect_good(const Outcome& o, std::size_t stacks) {
+  const LayerParams lp = make_job(PrintConfig{}).layers;
+  EXPECT_EQ(o.result.plan.stacks.size(), stacks);
+  EXPECT_TRUE(o.result.nonplanar);
+  EXPECT_LE(o.figures.deviation_p95, 0.02);
+  EXPECT_GT(o.figures.covered_samples, 0.95 * static_cast<double>(o.figures.surface_samples));
+  EXPECT_EQ(o.figures.collisions, 0u);
+  EXPECT_EQ(o.result.collisions, 0u);
+  EXPECT_LE(o.result.steepest_deg, lp.max_angle_deg + 0.5);
+  EXPECT_LE(o.figures.steepest_deg, lp.max_angle_deg + 0.5);
+  EXPECT_GE(o.result.thickness_min, lp.min_layer_height - 1e-3);
+  EXPECT_LE(o.result.thickness_max, lp.max_layer_height + 1e-3);
+  EXPECT_LT(o.figures.outside_fraction, 0.01);
+  for (const char* tag : {";TYPE:External perimeter", ";TYPE:Top solid infill", ";LAYER_CHANGE",
+                          ";HEIGHT:", ";WIDTH:"})
+    EXPECT_NE(o.gcode.find(tag), std::string::npos) << tag;
+  EXPECT_EQ(o.gcode.find("G2 "), std::string::npos);  // never arcs
+  EXPECT_EQ(o.gcode.find("G3 "), std::string::npos);
+}
+
+TEST(NonplanarPrint, Saddle) {
+  expect_good(
+      run(test::height_field_solid([](double x, double y) { return 10 + (x * x - y * y) / 60.0; },
+                                   -12, 12, -12, 12, 72, 72)),
+      1);
+}
+
+TEST(NonplanarPrint, SineRoofAtFullInfillKeepsItsVolume) {
+  PrintConfig c;
+  c.paths.fill_density = 1.0;
+  const Outcome o =
+      run(test::height_field_solid([](double x, double) { return 8 + std::sin(2 * M_PI * x / 25); },
+                                   0, 50, 0, 30, 150, 60),
+          c);
+  expect_good(o, 1);
+  EXPECT_NEAR(o.figures.volume_ratio, 1.0, 0.03);
+}
+
+TEST(NonplanarPrint, TwoCurvedTowers) {
+  // One closed solid: a 3 mm plate with two 20 × 20 mm towers whose tops are domes (as a
+  // height field, the towers' walls are one 0.5 mm grid step wide, far steeper than 30°).
+  auto top = [](double x, double y) {
+    for (double cx : {20.0, 60.0})
+      if (std::abs(x - cx) <= 10 && std::abs(y - 20) <= 10)
+        return 18 + 2.0 * std::cos(0.1 * (x - cx)) * std::cos(0.1 * (y - 20));
+    return 3.0;
+  };
+  expect_good(run(test::height_field_solid(top, 0, 80, 0, 40, 160, 80)), 2);
+}
+
+TEST(NonplanarPrint, DomeCutByABox) {
+  const double R = 40, a = 12;
+  expect_good(run(test::height_field_solid(
+                  [&](double x, double y) {
+                    return 6 + std::sqrt(R * R - x * x - y * y) - std::sqrt(R * R - 2 * a * a);
+                  },
+                  -a, a, -a, a, 72, 72)),
+              1);
+}
+
+TEST(NonplanarPrint, FlatTopsSlicePlanarWithANotice) {
+  const Outcome o = run(test::box({0, 0, 0}, {20, 20, 10}));
+  EXPECT_FALSE(o.result.nonplanar);
+  ASSERT_FALSE(o.result.notices.empty());
+  EXPECT_NE(o.result.notices.back().find("slicing planar"), std::string::npos);
+  EXPECT_NEAR(o.figures.steepest_deg, 0.0, 1e-9);
+}
+
+TEST(GcodeReader, RefusesArcsAndUnknownCommandsNamingTheLine) {
+  auto arc = read_gcode_moves("G90\nG1 X1 Y1 E1\nG2 X5 Y5 I1 J1 E2\n");
+  ASSERT_FALSE(arc);
+  EXPECT_NE(arc.error().message.find("line 3: arc"), std::string::npos) << arc.error().message;
+  auto junk = read_gcode_moves("G1 X1\nhello\n");
+  ASSERT_FALSE(junk);
+  EXPECT_NE(junk.error().message.find("line 2"), std::string::npos);
+  auto ok = read_gcode_moves("M83\nG1 X1 Y0 E0.5 ; note\nG92 E0\nT0\nM104 S200\n");
+  ASSERT_TRUE(ok) << ok.error().message;
+  EXPECT_EQ(ok->size(), 1u);
+  EXPECT_TRUE((*ok)[0].extruding);
+}
+
+}  // namespace
+}  // namespace nonplanar
