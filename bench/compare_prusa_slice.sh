@@ -1,16 +1,20 @@
 #!/usr/bin/env bash
-# Time `nonplanar slice --planar` against `prusa-slicer --export-gcode` with equivalent
-# settings on the same models, same machine, same run; print wall time, peak memory and
-# the ratios. Usage: bench/compare_prusa_slice.sh [RUNS=3] [MODEL...]
-# Default models: gen_3DBenchy.stl and np_stanford_bunny_closed_compas.stl from
-# ../shared/models. Installs prusa-slicer through scripts/setup.sh if needed, and builds.
+# Time `nonplanar slice` (both --planar and the full non-planar pipeline) against
+# `prusa-slicer --export-gcode` with equivalent settings on the same models, same machine,
+# same run; print wall time, peak memory and the ratios to PrusaSlicer.
+# Usage: bench/compare_prusa_slice.sh [RUNS=3] [MODEL...]
+# Default models: Benchy and the bunny (issue 5), the wing, FoilCutter and sphere (curved
+# tops) from ../shared/models, and examples/wave_roof.stl. Installs prusa-slicer through
+# scripts/setup.sh if needed, and builds.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 runs=${1:-3}
 shift || true
 models=("$@")
 if ((${#models[@]} == 0)); then
-  models=(../shared/models/gen_3DBenchy.stl ../shared/models/np_stanford_bunny_closed_compas.stl)
+  models=(../shared/models/gen_3DBenchy.stl ../shared/models/np_stanford_bunny_closed_compas.stl
+          ../shared/models/np_curvislicer_wing.stl ../shared/models/np_curvislicer_FoilCutter.stl
+          ../shared/models/np_prusa_sphere.stl examples/wave_roof.stl)
 fi
 SETUP_ARGS=--with-prusaslicer bash scripts/build.sh >/dev/null
 tmp=$(mktemp -d)
@@ -30,11 +34,15 @@ best() {  # best-of-N wall time (s) and that run's peak RSS (KB)
   done
   echo "$bt $bm"
 }
-printf "%-40s %10s %10s %10s %10s %7s %7s\n" model "np s" "ps s" "np MB" "ps MB" "t ratio" "m ratio"
+printf "%-36s %-10s %8s %8s %8s %8s %7s %7s\n" model mode "np s" "ps s" "np MB" "ps MB" "t ratio" "m ratio"
 for m in "${models[@]}"; do
-  read -r nt nm < <(best ./build/nonplanar slice -q "$m" -o "$tmp/np.gcode" --planar "${common[@]}")
   read -r pt pm < <(best prusa-slicer --export-gcode "${common[@]}" --gcode-flavor marlin2 \
     --bed-shape 0x0,220x0,220x220,0x220 --center 110,110 -o "$tmp/ps.gcode" "$m")
-  awk -v n="$(basename "$m")" -v a="$nt" -v b="$pt" -v c="$nm" -v d="$pm" \
-    'BEGIN{printf "%-40s %10.2f %10.2f %10.1f %10.1f %7.2f %7.2f\n", n, a, b, c/1024, d/1024, a/b, c/d}'
+  for mode in planar non-planar; do
+    flag=()
+    [[ $mode == planar ]] && flag=(--planar)
+    read -r nt nm < <(best ./build/nonplanar slice -q "$m" -o "$tmp/np.gcode" "${flag[@]}" "${common[@]}")
+    awk -v n="$(basename "$m")" -v md="$mode" -v a="$nt" -v b="$pt" -v c="$nm" -v d="$pm" \
+      'BEGIN{printf "%-36s %-10s %8.2f %8.2f %8.1f %8.1f %7.2f %7.2f\n", n, md, a, b, c/1024, d/1024, a/b, c/d}'
+  done
 done

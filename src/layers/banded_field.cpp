@@ -24,27 +24,40 @@ void cubic_weights(double t, double* w) {
 
 }  // namespace
 
-void Band::heights(double x, double y, double* S) const {
+Band::Basis Band::basis(double x, double y) const {
   const NurbsSurface& s = top.surface;
   const Vec2 uv = top.uv(x, y);
   const double u = std::clamp(uv.x(), 0.0, 1.0), v = std::clamp(uv.y(), 0.0, 1.0);
   const int su = nurbs::find_span(s.n_u, s.p, u, s.U), sv = nurbs::find_span(s.n_v, s.q, v, s.V);
-  double Nu[8], Nv[8], R[64];
+  double Nu[8], Nv[8];
   nurbs::basis_funs(su, u, s.p, s.U, Nu);
   nurbs::basis_funs(sv, v, s.q, s.V, Nv);
+  Basis b;
+  b.i0 = su - s.p, b.j0 = sv - s.q;
   double W = 0;
   for (int a = 0; a <= s.p; ++a)
     for (int c2 = 0; c2 <= s.q; ++c2) {
-      R[a * (s.q + 1) + c2] = Nu[a] * Nv[c2] * s.w(su - s.p + a, sv - s.q + c2);
-      W += R[a * (s.q + 1) + c2];
+      const double r = Nu[a] * Nv[c2] * s.w(b.i0 + a, b.j0 + c2);
+      b.R[a * (s.q + 1) + c2] = r;
+      W += r;
     }
-  for (int i = 0; i <= N; ++i) {
-    double z = 0;
-    for (int a = 0; a <= s.p; ++a)
-      for (int c2 = 0; c2 <= s.q; ++c2)
-        z += R[a * (s.q + 1) + c2] * Z(i, (su - s.p + a) * s.n_v + (sv - s.q + c2));
-    S[i] = z / W;
+  for (int k = 0; k < (s.p + 1) * (s.q + 1); ++k) b.R[k] /= W;
+  return b;
+}
+
+double Band::surface(const Basis& b, int i) const {
+  const NurbsSurface& s = top.surface;
+  double z = 0;
+  for (int a = 0; a <= s.p; ++a) {
+    const int row = (b.i0 + a) * s.n_v + b.j0;
+    for (int c2 = 0; c2 <= s.q; ++c2) z += b.R[a * (s.q + 1) + c2] * Z(i, row + c2);
   }
+  return z;
+}
+
+void Band::heights(double x, double y, double* S) const {
+  const Basis b = basis(x, y);
+  for (int i = 0; i <= N; ++i) S[i] = surface(b, i);
 }
 
 double Band::beta(double x, double y) const {
@@ -69,17 +82,26 @@ double Band::beta(double x, double y) const {
 
 double Band::delta(double x, double y, double z, const PlanarLayers& pl) const {
   if (z <= c) return 0.0;
-  double S[512];
-  heights(x, y, S);
-  if (z <= S[0]) {
-    int i = 0;
-    while (i + 1 < N && S[i + 1] > z) ++i;  // S decreases with i: S[i] ≥ z ≥ S[i+1]
-    const double gap = S[i] - S[i + 1];
-    const double s = i + (gap > 0 ? std::clamp((S[i] - z) / gap, 0.0, 1.0) : 0.0);
+  const Basis b = basis(x, y);
+  const double S0 = surface(b, 0);
+  if (z <= S0) {
+    // S decreases with i: binary search for S_i ≥ z ≥ S_{i+1}.
+    int lo = 0, hi = N;  // S_lo ≥ z, S_hi = c < z
+    double Slo = S0, Shi = surface(b, N);
+    while (hi - lo > 1) {
+      const int mid = (lo + hi) / 2;
+      const double Sm = surface(b, mid);
+      if (Sm >= z)
+        lo = mid, Slo = Sm;
+      else
+        hi = mid, Shi = Sm;
+    }
+    const double gap = Slo - Shi;
+    const double s = lo + (gap > 0 ? std::clamp((Slo - z) / gap, 0.0, 1.0) : 0.0);
     return (T_bottom + N - s) - pl.T(z);
   }
-  const double d0 = (T_bottom + N) - pl.T(S[0]);
-  return d0 * (1.0 - smoothstep((z - S[0]) / fade));
+  const double d0 = (T_bottom + N) - pl.T(S0);
+  return d0 * (1.0 - smoothstep((z - S0) / fade));
 }
 
 void set_blend(Band& b, const PatchRaster& r, double blend) {
@@ -105,6 +127,31 @@ double BandedField::T(double x, double y, double z) const {
 }
 
 double BandedField::z_at(double x, double y, double t) const {
+  // Closed forms first: where no band reaches, T is planar; where exactly one band has β = 1
+  // (on its patch), T inside the stack is T_bottom + N − s with s the fractional surface
+  // index, so z interpolates the two surfaces around s. Everywhere else, root-find.
+  const Band* only = nullptr;
+  bool mixed = false;
+  for (const Band& b : bands_) {
+    const double beta = b.beta(x, y);
+    if (beta <= 0) continue;
+    if (beta >= 1 - 1e-12 && !only)
+      only = &b;
+    else
+      mixed = true;
+  }
+  if (!only && !mixed) return pl_.zeta(t);
+  if (only && !mixed) {
+    if (t <= only->T_bottom) return pl_.zeta(t);
+    const double s = only->T_bottom + only->N - t;  // 0 at the top surface, N at the plane
+    if (s >= 0) {
+      const Band::Basis b = only->basis(x, y);
+      const int i = std::min(static_cast<int>(std::floor(s)), only->N - 1);
+      const double f = s - i;
+      const double Si = only->surface(b, i);
+      return Si + f * (only->surface(b, i + 1) - Si);
+    }
+  }
   // T increases in z: bracket around the planar guess, then bisection with a secant step
   // (Illinois) to 1e-10 mm.
   const double z0 = pl_.zeta(t);

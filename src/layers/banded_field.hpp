@@ -29,6 +29,14 @@ struct Band {
   int blend_nx = 0, blend_ny = 0;
   std::vector<double> blend;
 
+  /// The stack's shared rational basis at (x, y): evaluate once, then any surface cheaply.
+  struct Basis {
+    int i0 = 0, j0 = 0;
+    double R[64];
+  };
+  Basis basis(double x, double y) const;
+  /// S_i at the basis's point.
+  double surface(const Basis& b, int i) const;
   /// S_0 … S_N at (x, y) into S (size N + 1).
   void heights(double x, double y, double* S) const;
   double beta(double x, double y) const;

@@ -91,7 +91,7 @@ std::string check_blend(const BandedField& field, const Band& b, const ColumnCas
     zk[{i, j}] = std::move(z);
   }
   // Slopes between neighbouring columns that both have material at that layer.
-  const double tmax = std::tan((p.max_angle_deg + 0.5) * M_PI / 180.0);
+  const double tmax = std::tan(p.max_angle_deg * M_PI / 180.0);
   for (const auto& [ij, z] : zk) {
     for (const auto& nb :
          {std::pair{ij.first + stride, ij.second}, std::pair{ij.first, ij.second + stride}}) {
@@ -99,7 +99,7 @@ std::string check_blend(const BandedField& field, const Band& b, const ColumnCas
       if (it == zk.end()) continue;
       const double d = stride * b.blend_cell;
       for (std::size_t k = 0; k < std::min(z.size(), it->second.size()); ++k)
-        if (std::abs(it->second[k] - z[k]) / d > tmax * 1.02) {
+        if (std::abs(it->second[k] - z[k]) / d > tmax) {
           const double x = b.blend_origin.x() + ij.first * b.blend_cell;
           char buf[200];
           std::snprintf(buf, sizeof buf,

@@ -144,7 +144,7 @@ StackResult build_stack(const TriangleMesh& mesh, const Patch& patch, int patch_
     out.failure = "patch covers no sample of its grid";
     return out;
   }
-  if (top_slope > p.max_angle_deg + 0.5) {
+  if (top_slope > p.max_angle_deg) {
     out.failure =
         fmt2("surface slope %.1f deg exceeds max_angle %.1f deg", top_slope, p.max_angle_deg);
     return out;
@@ -247,7 +247,7 @@ StackResult build_stack(const TriangleMesh& mesh, const Patch& patch, int patch_
   Figures f = measure(grid, best, p);
   const auto ok = [&](const Figures& g) {
     return g.t_min >= p.min_layer_height - 1e-6 && g.t_max <= p.max_layer_height + 1e-6 &&
-           g.slope <= p.max_angle_deg + 0.5;
+           g.slope <= p.max_angle_deg;
   };
   if (!ok(f) || !(st.cost_after <= st.cost_before)) {
     // The optimiser traded a limit for cost (or did not get there): keep the paper's even
@@ -272,7 +272,7 @@ StackResult build_stack(const TriangleMesh& mesh, const Patch& patch, int patch_
     out.failure = fmt2("layer thickness %.3f to %.3f mm leaves the limits", f.t_min, f.t_max);
     return out;
   }
-  if (f.slope > p.max_angle_deg + 0.5) {
+  if (f.slope > p.max_angle_deg) {
     out.failure = fmt2("layer slope %.1f deg exceeds max_angle %.1f deg", f.slope, p.max_angle_deg);
     return out;
   }

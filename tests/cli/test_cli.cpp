@@ -172,6 +172,32 @@ TEST(Cli, SlicePlanarWritesGcodeAndRefusesBadSettings) {
   EXPECT_NE(q.err.find("q.ini: line 2: fill_density"), std::string::npos) << q.err;
 }
 
+TEST(Cli, SliceNonPlanarThenCheck) {
+  const auto dir = test::temp_dir("cli_nonplanar");
+  ASSERT_TRUE(write_stl(
+      dir / "roof.stl",
+      test::height_field_solid([](double x, double) { return 8 + std::sin(2 * M_PI * x / 25); }, 0,
+                               50, 0, 30, 150, 60)));
+  const std::string model = (dir / "roof.stl").string(), out = (dir / "roof.gcode").string();
+  const CliResult s = run("slice " + model + " -o " + out);
+  ASSERT_EQ(s.code, 0) << s.err;
+  EXPECT_NE(s.err.find("1 curved stack"), std::string::npos) << s.err;
+  EXPECT_NE(test::read_bytes(out).find("; mode: non-planar"), std::string::npos);
+  const CliResult c = run("check --json " + out + " --mesh " + model);
+  ASSERT_EQ(c.code, 0) << c.err;
+  const auto j = nlohmann::json::parse(c.out);
+  EXPECT_LE(j["top_surface_deviation"]["p95"].get<double>(), 0.02);
+  EXPECT_EQ(j["collisions"], 0);
+  EXPECT_LE(j["steepest_extrusion"].get<double>(), 30.5);
+  for (const char* k : {"thickness_min", "thickness_max", "volume_ratio", "outside_fraction"})
+    EXPECT_TRUE(j.contains(k)) << k;
+  // A foreign file with an arc: refused with its line.
+  test::write_bytes(dir / "arc.gcode", "G90\nG1 X1 Y1\nG3 X2 Y2 I1 J0 E1\n");
+  const CliResult a = run("check " + (dir / "arc.gcode").string() + " --mesh " + model);
+  EXPECT_EQ(a.code, 2);
+  EXPECT_NE(a.err.find("line 3"), std::string::npos) << a.err;
+}
+
 TEST(Cli, HelpAndUsage) {
   const CliResult h = run("analyze --help");
   EXPECT_EQ(h.code, 0);
