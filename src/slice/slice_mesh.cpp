@@ -70,17 +70,19 @@ std::vector<Polygon> layer_loops(const TriangleMesh& m, const std::vector<int>& 
     Polygon loop;
     int cur = static_cast<int>(s0);
     bool closed = false;
+    int last = cur;
     while (cur >= 0 && !used[cur]) {
       used[cur] = 1;
+      last = cur;
       loop.push_back(segs[cur].p);
       const auto it = starting.find(segs[cur].to);
-      if (it == starting.end()) {
-        loop.push_back(segs[cur].q);
-        break;
-      }
+      if (it == starting.end()) break;
       if (it->second == static_cast<int>(s0)) closed = true;
       cur = it->second;
     }
+    // An open fragment ends where its last segment ends, so fragments that continue one
+    // another meet exactly and are joined below.
+    if (!closed) loop.push_back(segs[last].q);
     if (closed)
       loops.push_back(std::move(loop));
     else if (loop.size() >= 2)
@@ -94,8 +96,10 @@ std::vector<Polygon> layer_loops(const TriangleMesh& m, const std::vector<int>& 
     open.pop_back();
     for (bool grew = true; grew;) {
       grew = false;
-      if ((chain.back() - chain.front()).norm() < gap) break;
-      double best = gap;
+      // Join the nearest chain that continues this one; close on itself only when no other
+      // chain is nearer (a chain starting just past the gap would otherwise close into a
+      // sliver).
+      double best = std::min(gap, (chain.back() - chain.front()).norm());
       std::size_t bi = open.size();
       for (std::size_t i = 0; i < open.size(); ++i) {
         const double d = (open[i].front() - chain.back()).norm();
