@@ -37,17 +37,15 @@ int run(FitOptions o) {
   }
   std::vector<SurfaceRecord> records;
   std::vector<SurfaceFit> fits;
-  for (std::size_t i = 0; i < analysis->patches.size(); ++i) {
-    const Patch& patch = analysis->patches[i];
-    if (!patch.needs_nonplanar()) continue;
-    auto fit = fit_patch(loaded->mesh, patch, o.fit, ctx);
-    if (!fit) {
-      finish_progress();
-      return report_error(fit.error());
-    }
-    records.push_back({static_cast<int>(i), fit->surface, fit->rms_error, fit->max_error});
-    fits.push_back(std::move(*fit));
+  std::vector<int> ids;
+  auto fitted = fit_patches(loaded->mesh, *analysis, o.fit, {}, &ids, ctx);
+  if (!fitted) {
+    finish_progress();
+    return report_error(fitted.error());
   }
+  fits = std::move(*fitted);
+  for (std::size_t k = 0; k < fits.size(); ++k)
+    records.push_back({ids[k], fits[k].surface, fits[k].rms_error, fits[k].max_error});
   finish_progress();
   report_warnings(o.mesh.model, *loaded, o.mesh.quiet);
   if (!o.export_surfaces.empty())

@@ -45,16 +45,10 @@ int run(LayersOptions o) {
   if (!loaded) return finish_progress(), report_error(loaded.error());
   auto analysis = analyze(loaded->mesh, o.analysis, ctx);
   if (!analysis) return finish_progress(), report_error(analysis.error());
-  std::vector<SurfaceFit> fits;
   std::vector<int> ids;
-  for (std::size_t i = 0; i < analysis->patches.size(); ++i) {
-    if (!analysis->patches[i].needs_nonplanar()) continue;
-    auto fit = fit_patch(loaded->mesh, analysis->patches[i], o.fit, ctx);
-    if (!fit) return finish_progress(), report_error(fit.error());
-    fits.push_back(std::move(*fit));
-    ids.push_back(static_cast<int>(i));
-  }
-  auto plan = plan_layers(loaded->mesh, *analysis, fits, ids, o.layers, ctx);
+  auto fits = fit_patches(loaded->mesh, *analysis, o.fit, {}, &ids, ctx);
+  if (!fits) return finish_progress(), report_error(fits.error());
+  auto plan = plan_layers(loaded->mesh, *analysis, *fits, ids, o.layers, ctx);
   if (!plan) return finish_progress(), report_error(plan.error());
   std::size_t split = 0;
   if (!o.export_normalized.empty()) {

@@ -81,6 +81,12 @@ struct FitError {
 FitError measure_fit_error(const HeightField& s, const TriangleMesh& mesh, const Patch& patch,
                            double density);
 
+/// Fits every patch of `analysis` that needs non-planar layers, except those listed in
+/// `skip`; *patch_ids gets the patch index of each fit (same order).
+Expected<std::vector<SurfaceFit>> fit_patches(const TriangleMesh& mesh, const Analysis& analysis,
+                                              const FitParams& params, const std::vector<int>& skip,
+                                              std::vector<int>* patch_ids, const Context& ctx);
+
 /// Fit one patch: samples, footprint and minimum span (the patch's median edge length) from
 /// the mesh, then fit_height_field. rms_error / max_error of the result are re-measured
 /// against the triangles with measure_fit_error.

@@ -37,18 +37,10 @@ Expected<SliceResult> attempt(const TriangleMesh& mesh, const SliceJob& job,
   if (!job.planar_only) {
     auto a = analyze(mesh, job.analysis, ctx);
     if (!a) return a.error();
-    std::vector<SurfaceFit> fits;
     std::vector<int> ids;
-    for (std::size_t i = 0; i < a->patches.size(); ++i) {
-      if (!a->patches[i].needs_nonplanar()) continue;
-      if (std::find(excluded.begin(), excluded.end(), static_cast<int>(i)) != excluded.end())
-        continue;
-      auto f = fit_patch(mesh, a->patches[i], job.fit, ctx);
-      if (!f) return f.error();
-      fits.push_back(std::move(*f));
-      ids.push_back(static_cast<int>(i));
-    }
-    auto plan = plan_layers(mesh, *a, fits, ids, job.layers, ctx);
+    auto fits = fit_patches(mesh, *a, job.fit, excluded, &ids, ctx);
+    if (!fits) return fits.error();
+    auto plan = plan_layers(mesh, *a, *fits, ids, job.layers, ctx);
     if (!plan) return plan.error();
     r.plan = std::move(*plan);
     for (const auto& fb : r.plan.fallbacks)

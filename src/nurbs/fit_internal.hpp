@@ -18,8 +18,10 @@ struct SampleBasis {
   void compute(const NurbsSurface& s, const std::vector<Vec3>& uvz);
 };
 
-/// Height of sample k from its stored basis (z of the rational surface).
-double sample_height(const NurbsSurface& s, const SampleBasis& b, int k);
+/// Height of sample k from its stored basis (z of the rational surface); *denominator, if
+/// given, gets D_k = Σ N w.
+double sample_height(const NurbsSurface& s, const SampleBasis& b, int k,
+                     double* denominator = nullptr);
 
 /// Residuals r_k = S_k − z_k; returns RMS, *max gets max |r|.
 double residuals(const NurbsSurface& s, const SampleBasis& b, const std::vector<Vec3>& uvz,

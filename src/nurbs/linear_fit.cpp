@@ -24,7 +24,7 @@ void SampleBasis::compute(const NurbsSurface& s, const std::vector<Vec3>& uvz) {
   }
 }
 
-double sample_height(const NurbsSurface& s, const SampleBasis& b, int k) {
+double sample_height(const NurbsSurface& s, const SampleBasis& b, int k, double* denominator) {
   const int mu = s.p + 1, mv = s.q + 1;
   const int i0 = b.su[k] - s.p, j0 = b.sv[k] - s.q;
   double num = 0, den = 0;
@@ -35,6 +35,7 @@ double sample_height(const NurbsSurface& s, const SampleBasis& b, int k) {
       num += nw * s.points[idx].z();
       den += nw;
     }
+  if (denominator) *denominator = den;
   return num / den;
 }
 

@@ -244,15 +244,8 @@ NonlinearReport gauss_newton(NurbsSurface& s, const SampleBasis& b, const std::v
     GridNormalEquations ne(s.n_u, s.n_v, s.p, s.q, free_w ? 2 : 1);
     for (std::size_t k = 0; k < uvz.size(); ++k) {
       const int i0 = b.su[k] - s.p, j0 = b.sv[k] - s.q;
-      double num = 0, den = 0;
-      for (int a = 0; a < mu; ++a)
-        for (int c = 0; c < mv; ++c) {
-          const std::size_t idx = static_cast<std::size_t>(i0 + a) * s.n_v + (j0 + c);
-          const double nw = b.nu[k * mu + a] * b.nv[k * mv + c] * s.weights[idx];
-          num += nw * s.points[idx].z();
-          den += nw;
-        }
-      const double S = num / den, r = S - uvz[k].z();
+      double den = 0;
+      const double S = sample_height(s, b, static_cast<int>(k), &den), r = S - uvz[k].z();
       for (int a = 0; a < mu; ++a)
         for (int c = 0; c < mv; ++c) {
           const std::size_t idx = static_cast<std::size_t>(i0 + a) * s.n_v + (j0 + c);

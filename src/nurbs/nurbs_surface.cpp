@@ -180,28 +180,29 @@ void NurbsSurface::insert_knot_u(double u, int r) {
   U = std::move(newU);
 }
 
-void NurbsSurface::insert_knot_v(double v, int r) {
-  std::vector<double> newV;
-  std::vector<std::vector<Vec4>> rows(n_u);
-  for (int i = 0; i < n_u; ++i) {
-    std::vector<Vec4> Pw(n_v);
-    for (int j = 0; j < n_v; ++j) Pw[j] << w(i, j) * P(i, j), w(i, j);
-    std::vector<double> VP = V;
-    insert_knot_curve(q, VP, Pw, v, r);
-    rows[i] = std::move(Pw);
-    newV = std::move(VP);
-  }
-  const int nn = static_cast<int>(rows[0].size());
-  points.assign(static_cast<std::size_t>(n_u) * nn, Vec3::Zero());
-  weights.assign(static_cast<std::size_t>(n_u) * nn, 1.0);
-  for (int i = 0; i < n_u; ++i)
-    for (int j = 0; j < nn; ++j) {
-      const Vec4& h = rows[i][j];
-      points[static_cast<std::size_t>(i) * nn + j] = h.head<3>() / h[3];
-      weights[static_cast<std::size_t>(i) * nn + j] = h[3];
+namespace {
+
+// The same surface with u and v swapped (P_ij ↦ P_ji): a v-direction operation is the
+// u-direction one on the transpose.
+NurbsSurface transposed(const NurbsSurface& s) {
+  NurbsSurface t;
+  t.p = s.q, t.q = s.p, t.n_u = s.n_v, t.n_v = s.n_u, t.U = s.V, t.V = s.U;
+  t.points.resize(s.points.size());
+  t.weights.resize(s.weights.size());
+  for (int i = 0; i < s.n_u; ++i)
+    for (int j = 0; j < s.n_v; ++j) {
+      t.points[static_cast<std::size_t>(j) * s.n_u + i] = s.P(i, j);
+      t.weights[static_cast<std::size_t>(j) * s.n_u + i] = s.w(i, j);
     }
-  n_v = nn;
-  V = std::move(newV);
+  return t;
+}
+
+}  // namespace
+
+void NurbsSurface::insert_knot_v(double v, int r) {
+  NurbsSurface t = transposed(*this);
+  t.insert_knot_u(v, r);
+  *this = transposed(t);
 }
 
 double HeightField::height(double x, double y) const {

@@ -51,6 +51,22 @@ FitError measure_fit_error(const HeightField& s, const TriangleMesh& mesh, const
   return e;
 }
 
+Expected<std::vector<SurfaceFit>> fit_patches(const TriangleMesh& mesh, const Analysis& analysis,
+                                              const FitParams& params, const std::vector<int>& skip,
+                                              std::vector<int>* patch_ids, const Context& ctx) {
+  std::vector<SurfaceFit> fits;
+  patch_ids->clear();
+  for (std::size_t i = 0; i < analysis.patches.size(); ++i) {
+    if (!analysis.patches[i].needs_nonplanar()) continue;
+    if (std::find(skip.begin(), skip.end(), static_cast<int>(i)) != skip.end()) continue;
+    auto f = fit_patch(mesh, analysis.patches[i], params, ctx);
+    if (!f) return f.error();
+    fits.push_back(std::move(*f));
+    patch_ids->push_back(static_cast<int>(i));
+  }
+  return fits;
+}
+
 Expected<SurfaceFit> fit_patch(const TriangleMesh& mesh, const Patch& patch,
                                const FitParams& params, const Context& ctx) {
   if (patch.faces.empty()) return Error{Status::invalid_argument, "fit: empty patch"};
