@@ -132,8 +132,12 @@ StackResult build_stack(const TriangleMesh& mesh, const Patch& patch, int patch_
   int on_count = 0;
   for (int k = 0; k < n; ++k) {
     top_z[k] = top.height(grid.xy[k].x(), grid.xy[k].y());
-    zmin = std::min(zmin, top_z[k]);
-    zmax = std::max(zmax, top_z[k]);
+    // Relief over the patch itself: off it, the fit is held only by its smoothness term and
+    // may swing (the blend check below judges the layers there, in the material).
+    if (grid.on_patch[k]) {
+      zmin = std::min(zmin, top_z[k]);
+      zmax = std::max(zmax, top_z[k]);
+    }
     if (grid.on_patch[k]) {
       on_sum += top_z[k], ++on_count;
       top_slope = std::max(top_slope,
