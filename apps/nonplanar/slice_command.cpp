@@ -17,7 +17,8 @@ struct SliceOptions {
   bool planar = false;
   double max_angle = 30.0;
   // Overrides, applied by key after the profile, in this order.
-  std::vector<std::pair<std::string, std::string*>> named;
+  std::vector<std::pair<std::string, std::string*>> named;  // points into values
+  std::vector<std::string> values;
   std::vector<std::string> sets;
 };
 
@@ -120,14 +121,14 @@ void register_slice(CLI::App& app, std::function<int()>* run_fn) {
       {"gcode_flavor", "marlin2, klipper or reprapfirmware"},
       {"use_relative_e_distances", "1 for relative E (M83)"},
   };
-  static std::vector<std::string> values(std::size(keys));
+  o->values.resize(std::size(keys));  // sized once: named keeps pointers into it
   for (std::size_t i = 0; i < std::size(keys); ++i) {
     std::string flag = std::string("--") + keys[i][0];
     for (char& ch : flag)
       if (ch == '_') ch = '-';
     if (flag == "--use-relative-e-distances") flag = "--relative-e";
-    cmd->add_option(flag, values[i], keys[i][1]);
-    o->named.emplace_back(keys[i][0], &values[i]);
+    cmd->add_option(flag, o->values[i], keys[i][1]);
+    o->named.emplace_back(keys[i][0], &o->values[i]);
   }
   cmd->add_option("--set", o->sets, "Any setting by its PrusaSlicer key: --set KEY=VALUE");
   *run_fn = nullptr;
