@@ -1,25 +1,73 @@
 #!/usr/bin/env bash
-# Build the parser fuzzer with clang-14 (libFuzzer, AddressSanitizer, UndefinedBehaviorSanitizer)
-# and run it. Usage: fuzz/run.sh [SECONDS=60]. Seeds: ../shared/models and tests/data.
+# Run the libFuzzer targets (one per parser; AddressSanitizer + UndefinedBehaviorSanitizer).
+# Usage: fuzz/run.sh [SECONDS=60] [TARGET...]
+#   TARGET: stl obj off 3mf ini json surfaces gcode (default: all of them, two at a time).
+# Builds build-san/ through scripts/sanitize.sh's configuration if the targets are missing.
+# Seeds come from ../shared/models and tests/data; corpora grow in build-san/corpus/TARGET,
+# so longer runs pick up where the last one stopped. Findings are written to
+# build-san/findings/ and the script fails when any target crashes, leaks or reports UB.
+# To fuzz longer, e.g. an hour per target: fuzz/run.sh 3600
 set -euo pipefail
 cd "$(dirname "$0")/.."
 secs=${1:-60}
-out=build-fuzz
-mkdir -p "$out/corpus"
-srcs=(src/io/mesh_buffer.cpp src/io/stl_reader.cpp src/io/obj_reader.cpp src/io/off_reader.cpp
-      src/config/print_config.cpp src/config/config_loader.cpp src/check/gcode_reader.cpp
-      src/nurbs/surface_io.cpp src/nurbs/nurbs_surface.cpp src/nurbs/bspline_basis.cpp
-      src/core/atomic_file.cpp src/core/status.cpp src/gcode/gcode_writer.cpp
-      src/toolpaths/make_toolpaths.cpp src/toolpaths/perimeters.cpp src/toolpaths/infill.cpp
-      src/toolpaths/ordering.cpp src/slice/polygon_ops.cpp)
-clang++-14 -std=c++20 -O1 -g -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined \
-  -Iinclude -Isrc -I/usr/include/eigen3 -I/usr/include/lib3mf \
-  fuzz/fuzz_parsers.cpp "${srcs[@]}" -lpolyclipping -ltbb -o "$out/fuzz_parsers"
-# Seeds: each shared model under each parser's selector byte (small files only).
-for f in ../shared/models/*.{stl,obj,off} tests/data/*.ini; do
-  [[ -f $f && $(stat -c %s "$f") -lt 300000 ]] || continue
-  for sel in 0 1 2 3; do { printf "\\x0$sel"; cat "$f"; } >"$out/corpus/$(basename "$f").$sel"; done
-done
-printf '\x04{"layer_height": 0.2, "fill_density": "20%%"}' >"$out/corpus/profile.json"
-printf '\x06G90\nM83\nG1 X1 Y2 Z0.2 E0.5 F1200\nG92 E0\n;TYPE:Perimeter\n' >"$out/corpus/g.gcode"
-"$out/fuzz_parsers" -max_total_time="$secs" -rss_limit_mb=2048 -max_len=65536 "$out/corpus"
+shift || true
+targets=("$@")
+((${#targets[@]})) || targets=(stl obj off 3mf ini json surfaces gcode)
+out=${BUILD_DIR:-build-san}
+missing=0
+for t in "${targets[@]}"; do [[ -x "$out/fuzz/fuzz_$t" ]] || missing=1; done
+if ((missing)); then
+  bash scripts/setup.sh --with-clang
+  CXX=clang++-14 cmake -S . -B "$out" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DNONPLANAR_FUZZ=ON \
+    -DNONPLANAR_BUILD_BENCH=OFF >/dev/null
+  cmake --build "$out" -j"$(nproc)" --target "${targets[@]/#/fuzz_}"
+fi
+
+models=../shared/models
+seed() {  # seed TARGET FILE...: copy small files into the target's corpus
+  local t=$1
+  shift
+  mkdir -p "$out/corpus/$t"
+  for f in "$@"; do
+    [[ -f $f && $(stat -c %s "$f") -lt 300000 ]] && cp "$f" "$out/corpus/$t/" || true
+  done
+}
+seed stl "$models"/*.stl
+seed obj "$models"/*.obj
+seed off "$models"/*.off
+seed ini tests/data/*.ini
+mkdir -p "$out/corpus/json" "$out/corpus/surfaces" "$out/corpus/gcode" "$out/corpus/3mf"
+printf '{"layer_height": 0.2, "fill_density": "20%%", "bed_shape": "0x0,220x0,220x220,0x220"}' \
+  >"$out/corpus/json/profile.json"
+printf '%s' '{"format":"nonplanar-surfaces","version":1,"surfaces":[{"patch":0,"degree_u":2,'\
+'"degree_v":2,"knots_u":[0,0,0,1,1,1],"knots_v":[0,0,0,1,1,1],"control_points":'\
+'[[[0,0,0,1],[0,1,0,1],[0,2,0,1]],[[1,0,0,1],[1,1,1,1],[1,2,0,1]],[[2,0,0,1],[2,1,0,1],'\
+'[2,2,0,1]]]}]}' >"$out/corpus/surfaces/one.json"
+printf 'G90\nM83\nG92 E0\n;LAYER_CHANGE\n;Z:0.2\n;TYPE:Perimeter\nG1 X1 Y2 Z0.2 E0.5 F1200\nG1 E-0.8 F2100\nG0 X5 Y5\n' \
+  >"$out/corpus/gcode/moves.gcode"
+# A minimal 3MF package (one tetrahedron), zipped here so no binary lives in the repository.
+tmf=$(mktemp -d)
+mkdir -p "$tmf/_rels" "$tmf/3D"
+printf '<?xml version="1.0" encoding="UTF-8"?>\n<Types xmlns="http://schemas.openxmlformats.org/package/2006/content-types"><Default Extension="rels" ContentType="application/vnd.openxmlformats-package.relationships+xml"/><Default Extension="model" ContentType="application/vnd.ms-package.3dmanufacturing-3dmodel+xml"/></Types>' >"$tmf/[Content_Types].xml"
+printf '<?xml version="1.0" encoding="UTF-8"?>\n<Relationships xmlns="http://schemas.openxmlformats.org/package/2006/relationships"><Relationship Target="/3D/3dmodel.model" Id="rel0" Type="http://schemas.microsoft.com/3dmanufacturing/2013/01/3dmodel"/></Relationships>' >"$tmf/_rels/.rels"
+printf '<?xml version="1.0" encoding="UTF-8"?>\n<model unit="millimeter" xmlns="http://schemas.microsoft.com/3dmanufacturing/core/2015/02"><resources><object id="1" type="model"><mesh><vertices><vertex x="0" y="0" z="0"/><vertex x="10" y="0" z="0"/><vertex x="0" y="10" z="0"/><vertex x="0" y="0" z="10"/></vertices><triangles><triangle v1="0" v2="2" v3="1"/><triangle v1="0" v2="1" v3="3"/><triangle v1="1" v2="2" v3="3"/><triangle v1="0" v2="3" v3="2"/></triangles></mesh></object></resources><build><item objectid="1" transform="1 0 0 0 1 0 0 0 1 5 5 0"/></build></model>' >"$tmf/3D/3dmodel.model"
+(cd "$tmf" && zip -q -X -r "$OLDPWD/$out/corpus/3mf/tetra.3mf" '[Content_Types].xml' _rels 3D)
+rm -rf "$tmf"
+
+mkdir -p "$out/findings"
+export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1}
+export LSAN_OPTIONS=${LSAN_OPTIONS:-suppressions=$PWD/scripts/lsan.supp:print_suppressions=0}
+run_one() {  # run_one TARGET: fuzz for $secs seconds; prints the executions
+  local t=$1 log="$out/findings/$1.log"
+  if "$out/fuzz/fuzz_$t" -max_total_time="$secs" -rss_limit_mb=2048 -max_len=65536 -timeout=10 \
+    -artifact_prefix="$out/findings/$t-" -print_final_stats=1 "$out/corpus/$t" >"$log" 2>&1; then
+    echo "fuzz_$t: $(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$') executions in ${secs} s, no findings"
+  else
+    echo "fuzz_$t: FAILED, see $log:"
+    grep -m5 -E 'ERROR|SUMMARY|runtime error' "$log" || tail -5 "$log"
+    return 1
+  fi
+}
+export -f run_one
+export out secs
+printf '%s\n' "${targets[@]}" | xargs -P 2 -I{} bash -c 'run_one {}'

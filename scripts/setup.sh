@@ -3,9 +3,11 @@
 # Idempotent: packages already present are skipped, and apt is not touched at all when
 # nothing is missing. Run as root on Debian 12 (uses sudo when not root and available).
 #
-# Usage: scripts/setup.sh [--with-prusaslicer]
+# Usage: scripts/setup.sh [--with-prusaslicer] [--with-clang]
 #   --with-prusaslicer  also install prusa-slicer (planar reference in benchmarks, external
 #                       engine); large, so only the benchmark/engine paths ask for it.
+#   --with-clang        also install clang-14 and its sanitizer/libFuzzer runtimes
+#                       (scripts/sanitize.sh, fuzz/run.sh).
 set -euo pipefail
 
 pkgs=(
@@ -15,9 +17,13 @@ pkgs=(
   libgtest-dev libgmock-dev libbenchmark-dev
   zip unzip time
 )
-if [[ "${1:-}" == "--with-prusaslicer" ]]; then
-  pkgs+=(prusa-slicer)
-fi
+for arg in "$@"; do
+  case "$arg" in
+    --with-prusaslicer) pkgs+=(prusa-slicer) ;;
+    --with-clang) pkgs+=(clang-14 libclang-rt-14-dev) ;;
+    *) echo "error: setup: unknown option '$arg'" >&2; exit 2 ;;
+  esac
+done
 
 missing=()
 for p in "${pkgs[@]}"; do

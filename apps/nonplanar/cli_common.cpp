@@ -2,11 +2,36 @@
 
 #include <unistd.h>
 
+#include <atomic>
+#include <csignal>
 #include <cstdio>
+
+#include "core/atomic_file.hpp"
 
 namespace nonplanar::cli {
 namespace {
 bool g_progress_drawn = false;
+std::atomic<bool> g_interrupted{false};
+
+// First Ctrl-C (or SIGTERM): ask the stages to stop; they return Status::cancelled and the
+// atomic writer removes its temporary. A second one: remove the temporary and leave now.
+// Only async-signal-safe calls here (unlink, write, _exit).
+extern "C" void on_interrupt(int) {
+  if (g_interrupted.exchange(true)) {
+    remove_pending_temporary_file();
+    constexpr char msg[] = "\nerror: interrupted\n";
+    (void)!::write(STDERR_FILENO, msg, sizeof msg - 1);
+    ::_exit(kExitInterrupted);
+  }
+}
+}  // namespace
+
+void install_interrupt_handler() {
+  struct sigaction sa {};
+  sa.sa_handler = on_interrupt;
+  sigemptyset(&sa.sa_mask);
+  sigaction(SIGINT, &sa, nullptr);
+  sigaction(SIGTERM, &sa, nullptr);
 }
 
 void MeshOptions::add_to(CLI::App& cmd) {
@@ -40,6 +65,10 @@ void add_analysis_options(CLI::App& cmd, AnalysisParams& p) {
 }
 
 int report_error(const Error& e) {
+  if (e.status == Status::cancelled) {
+    std::fprintf(stderr, "error: interrupted; nothing was written\n");
+    return kExitInterrupted;
+  }
   std::fprintf(stderr, "error: %s\n", e.message.c_str());
   switch (e.status) {
     case Status::invalid_argument:
@@ -61,6 +90,7 @@ void report_warnings(const std::string& file, const LoadedMesh& m, bool quiet) {
 
 Context make_context(bool quiet) {
   Context ctx;
+  ctx.cancel_flag = &g_interrupted;
   if (!quiet && ::isatty(STDERR_FILENO)) {
     ctx.on_progress = [](std::string_view stage, double f) {
       std::fprintf(stderr, "\r%-10.*s %3d%%", static_cast<int>(stage.size()), stage.data(),

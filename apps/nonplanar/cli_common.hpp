@@ -17,6 +17,11 @@ namespace nonplanar::cli {
 constexpr int kExitOk = 0;
 constexpr int kExitFailure = 1;
 constexpr int kExitBadInput = 2;
+constexpr int kExitInterrupted = 130;  ///< 128 + SIGINT, as shells report it
+
+/// Ctrl-C / SIGTERM raise the flag every make_context() Context carries; a second one exits
+/// at once after removing any half-written temporary file. Call once from main.
+void install_interrupt_handler();
 
 /// Options for reading and placing the model, added to a subcommand.
 struct MeshOptions {
@@ -33,7 +38,8 @@ void add_analysis_options(CLI::App& cmd, AnalysisParams& p);
 int report_error(const Error& e);
 /// Prints "warning: FILE: MESSAGE" for each loader warning (unless quiet).
 void report_warnings(const std::string& file, const LoadedMesh& m, bool quiet);
-/// A Context that draws a progress line on stderr when it is a terminal and not quiet.
+/// A Context that stops on Ctrl-C and draws a progress line on stderr when it is a terminal and not
+/// quiet.
 Context make_context(bool quiet);
 /// Clears the progress line, if one was drawn.
 void finish_progress();

@@ -27,6 +27,7 @@ int main(int argc, char** argv) {
     const int rc = app.exit(e);
     return rc == 0 ? kExitOk : kExitBadInput;
   }
+  install_interrupt_handler();
   try {
     return run ? run() : kExitBadInput;
   } catch (const std::bad_alloc&) {

@@ -1,5 +1,5 @@
-// `nonplanar slice`: mesh → layers → toolpaths → G-code. Today the planar engine
-// (--planar); the non-planar pipeline builds on it.
+// `nonplanar slice`: mesh → curved layers → toolpaths → G-code (the whole pipeline of
+// DESIGN.md §2; --planar for flat layers only).
 #include <cstdio>
 #include <memory>
 
@@ -46,6 +46,8 @@ int run(const SliceOptions& o) {
     if (int rc = apply(kv.substr(0, eq), kv.substr(eq + 1))) return rc;
   }
   if (auto v = validate_config(cfg); !v) return report_error(v.error());
+  if (!(o.max_angle > 0 && o.max_angle < 90))  // also catches NaN
+    return report_error({Status::invalid_argument, "max_angle: must be in (0, 90) degrees"});
   if (!o.mesh.quiet)
     for (const auto& n : cfg.notes) std::fprintf(stderr, "warning: %s\n", n.c_str());
 
@@ -56,16 +58,20 @@ int run(const SliceOptions& o) {
   if (!loaded) return finish_progress(), report_error(loaded.error());
   const BoundingBox box = bounding_box(loaded->mesh);
   const Vec2 bed = cfg.bed_max - cfg.bed_min;
-  if (box.size().x() > bed.x() + 1e-6 || box.size().y() > bed.y() + 1e-6)
-    return finish_progress(),
-           report_error({Status::invalid_argument,
-                         o.mesh.model + ": part is " + std::to_string(box.size().x()) + " x " +
-                             std::to_string(box.size().y()) + " mm, larger than the bed (" +
-                             std::to_string(bed.x()) + " x " + std::to_string(bed.y()) + " mm)"});
+  if (box.size().x() > bed.x() + 1e-6 || box.size().y() > bed.y() + 1e-6) {
+    char buf[160];
+    std::snprintf(buf, sizeof buf, ": part is %.1f x %.1f mm, larger than the bed (%.1f x %.1f mm)",
+                  box.size().x(), box.size().y(), bed.x(), bed.y());
+    return finish_progress(), report_error({Status::invalid_argument, o.mesh.model + buf});
+  }
   SliceJob job = make_job(cfg, o.max_angle);
   job.planar_only = o.planar;
   auto result = slice_model(loaded->mesh, job, ctx);
-  if (!result) return finish_progress(), report_error(result.error());
+  if (!result) {
+    Error e = result.error();
+    if (e.status == Status::invalid_mesh) e.message = o.mesh.model + ": " + e.message;
+    return finish_progress(), report_error(e);
+  }
   std::vector<std::string> header = result->header;
   header.push_back("model: " + o.mesh.model);
   auto w = write_gcode_file(o.output, result->layers, cfg, header, ctx);
@@ -105,6 +111,8 @@ void register_slice(CLI::App& app, std::function<int()>* run_fn) {
   static const char* keys[][2] = {
       {"layer_height", "Layer height (mm)"},
       {"first_layer_height", "First layer height (mm or %)"},
+      {"min_layer_height", "Thinnest curved layer, h_min (mm; 0 = automatic)"},
+      {"max_layer_height", "Thickest curved layer, h_max (mm; 0 = automatic)"},
       {"fill_density", "Sparse infill density (0.2 or 20%)"},
       {"fill_pattern", "rectilinear or grid"},
       {"perimeters", "Perimeter loops"},

@@ -41,6 +41,9 @@ struct CheckParams {
   double block_radius = 8, block_clearance = 4;
   double filament_diameter = 1.75;
   double surface_samples_per_mm2 = 2;
+  /// Only steepest extrusion and collisions (the slicer's safety gate, which measures
+  /// thickness from its own paths): thickness, volume and deviation are left at 0.
+  bool collisions_only = false;
 };
 
 /// The figures of DESIGN.md §4. Deviation is vertical, mm; thickness is the height of each

@@ -65,6 +65,10 @@ struct GcodeParams {
 /// Everything a print needs.
 struct PrintConfig {
   Vec2 bed_min{0, 0}, bed_max{220, 220};  ///< bed_shape's bounding box
+  /// Thinnest and thickest layer the printer prints well, h_min and h_max of the curved layers
+  /// (PrusaSlicer's min_layer_height / max_layer_height, mm). 0 = automatic:
+  /// h_min = min(0.1, layer_height), h_max = max(1.5 layer_height, min(0.75 nozzle, 0.3)).
+  double min_layer_height = 0, max_layer_height = 0;
   SliceParams slice;
   ToolpathParams paths;
   GcodeParams gcode;

@@ -7,6 +7,8 @@
 // z(q) − z(p) − max(0, |q − p| − r)·tan α (cone) or z(q) − z(p) − H (block).
 #include <algorithm>
 #include <cmath>
+#include <optional>
+#include <tuple>
 #include <unordered_map>
 
 #include <Eigen/Eigenvalues>
@@ -24,30 +26,81 @@ struct Pt {
   int layer;
 };
 
-// Extrusion points binned on an XY grid of kNear cells.
+// Extrusion points binned on an XY grid of kNear cells: one array sorted by (cell, layer),
+// with the range of every (cell, layer) for the plane fits, which read one layer, and of
+// every cell for "the highest layer here". (One list per cell made every plane fit walk all
+// layers above that cell, quadratic in the part's height; a vector per (cell, layer) spent
+// most of the time in the allocator.)
 class PointGrid {
  public:
-  void add(const Pt& q) { cells_[key(q.p.x(), q.p.y())].push_back(q); }
+  explicit PointGrid(std::vector<Pt> pts) : pts_(std::move(pts)) {
+    std::vector<std::pair<Key, std::size_t>> order(pts_.size());
+    for (std::size_t k = 0; k < pts_.size(); ++k)
+      order[k] = {Key{cell(pts_[k].p.x()), cell(pts_[k].p.y()), pts_[k].layer}, k};
+    std::sort(order.begin(), order.end(), [](const auto& u, const auto& v) {
+      return std::tie(u.first.i, u.first.j, u.first.layer, u.second) <
+             std::tie(v.first.i, v.first.j, v.first.layer, v.second);
+    });
+    std::vector<Pt> sorted(pts_.size());
+    for (std::size_t k = 0; k < order.size(); ++k) sorted[k] = pts_[order[k].second];
+    pts_ = std::move(sorted);
+    by_layer_.reserve(order.size() / 8 + 1);
+    for (std::size_t k = 0; k < order.size();) {
+      std::size_t e = k;
+      while (e < order.size() && order[e].first == order[k].first) ++e;
+      by_layer_.emplace(order[k].first, Range{k, e});
+      const Key c{order[k].first.i, order[k].first.j, 0};
+      auto [it, fresh] = by_cell_.try_emplace(c, Range{k, e});
+      if (!fresh) it->second.end = e;
+      k = e;
+    }
+  }
+  const std::vector<Pt>& points() const { return pts_; }
+  /// Calls f on every point of `layer` in the 3 x 3 cells around (x, y).
   template <class F>
-  void near(double x, double y, F&& f) const {
-    const long i = static_cast<long>(std::floor(x / kNear)),
-               j = static_cast<long>(std::floor(y / kNear));
+  void near(double x, double y, int layer, F&& f) const {
+    const long i = cell(x), j = cell(y);
     for (long a = i - 1; a <= i + 1; ++a)
       for (long b = j - 1; b <= j + 1; ++b) {
-        const auto it = cells_.find(pack(a, b));
-        if (it == cells_.end()) continue;
-        for (const Pt& q : it->second) f(q);
+        const auto it = by_layer_.find(Key{a, b, layer});
+        if (it == by_layer_.end()) continue;
+        for (std::size_t k = it->second.begin; k < it->second.end; ++k) f(pts_[k]);
       }
+  }
+  /// The highest layer with a point within r (≤ kNear) of (x, y), or -1.
+  int top_layer(double x, double y, double r) const {
+    const long i = cell(x), j = cell(y);
+    int top = -1;
+    for (long a = i - 1; a <= i + 1; ++a)
+      for (long b = j - 1; b <= j + 1; ++b) {
+        const auto it = by_cell_.find(Key{a, b, 0});
+        if (it == by_cell_.end()) continue;
+        // Sorted by layer within a cell: scan down from the top, stop at the best so far.
+        for (std::size_t k = it->second.end; k-- > it->second.begin && pts_[k].layer > top;)
+          if ((pts_[k].p.head<2>() - Vec2(x, y)).squaredNorm() <= r * r) top = pts_[k].layer;
+      }
+    return top;
   }
 
  private:
-  static long long pack(long a, long b) {
-    return (static_cast<long long>(a) << 32) ^ (b & 0xffffffffLL);
-  }
-  static long long key(double x, double y) {
-    return pack(static_cast<long>(std::floor(x / kNear)), static_cast<long>(std::floor(y / kNear)));
-  }
-  std::unordered_map<long long, std::vector<Pt>> cells_;
+  static long cell(double x) { return static_cast<long>(std::floor(x / kNear)); }
+  struct Key {
+    long i, j;
+    int layer;
+    bool operator==(const Key&) const = default;
+  };
+  struct Hash {
+    std::size_t operator()(const Key& k) const {
+      return std::hash<long long>()((static_cast<long long>(k.i) * 73856093) ^
+                                    (static_cast<long long>(k.j) * 19349663) ^
+                                    (static_cast<long long>(k.layer) * 83492791));
+    }
+  };
+  struct Range {
+    std::size_t begin, end;
+  };
+  std::vector<Pt> pts_;
+  std::unordered_map<Key, Range, Hash> by_layer_, by_cell_;
 };
 
 // z of the least-squares plane through points of `layer` within kNear of (x, y). Points
@@ -58,8 +111,7 @@ bool plane_z(const PointGrid& g, int layer, double x, double y, double* z) {
   Eigen::Vector3d b = Eigen::Vector3d::Zero();
   int n = 0;
   double nearest = 1e300, z_near = 0;
-  g.near(x, y, [&](const Pt& q) {
-    if (q.layer != layer) return;
+  g.near(x, y, layer, [&](const Pt& q) {
     const double dx = q.p.x() - x, dy = q.p.y() - y, d2 = dx * dx + dy * dy;
     if (d2 > kNear * kNear) return;
     const Eigen::Vector3d r(1, dx, dy);
@@ -161,7 +213,6 @@ Expected<CheckFigures> check_print(const std::vector<PrintMove>& moves, const Tr
     return m.extruding && m.layer >= 0 && m.type != "Skirt/Brim";
   };
   // Extrusion points and extents.
-  PointGrid grid;
   std::vector<Pt> pts;
   Vec2 lo(1e300, 1e300), hi(-1e300, -1e300);
   double filament = 0;
@@ -174,7 +225,6 @@ Expected<CheckFigures> check_print(const std::vector<PrintMove>& moves, const Tr
     for (int k = 1; k <= n; ++k) {
       const Pt q{m.from + (m.to - m.from) * (static_cast<double>(k) / n), m.layer};
       pts.push_back(q);
-      grid.add(q);
       lo = lo.cwiseMin(q.p.head<2>()), hi = hi.cwiseMax(q.p.head<2>());
     }
     const double dxy = (m.to.head<2>() - m.from.head<2>()).norm();
@@ -187,22 +237,30 @@ Expected<CheckFigures> check_print(const std::vector<PrintMove>& moves, const Tr
   if (ctx.cancelled()) return Error{Status::cancelled, "cancelled"};
 
   // Thickness: height above the previous layer's extrusions there (first layer: the bed).
-  f.thickness_min = 1e300, f.thickness_max = 0;
-  for (std::size_t k = 0; k < pts.size(); k += 3) {
-    const Pt& q = pts[k];
-    double below = 0;
-    if (q.layer > 0 && !plane_z(grid, q.layer - 1, q.p.x(), q.p.y(), &below)) continue;  // bridge
-    const double t = q.p.z() - below;
-    f.thickness_min = std::min(f.thickness_min, t);
-    f.thickness_max = std::max(f.thickness_max, t);
+  std::optional<PointGrid> grid;
+  if (!cp.collisions_only) {
+    grid.emplace(std::move(pts));
+    f.thickness_min = 1e300, f.thickness_max = 0;
+    const std::vector<Pt>& all = grid->points();
+    for (std::size_t k = 0; k < all.size(); k += 3) {
+      const Pt& q = all[k];
+      double below = 0;
+      if (q.layer > 0 && !plane_z(*grid, q.layer - 1, q.p.x(), q.p.y(), &below)) continue;
+      const double t = q.p.z() - below;  // (no plane below: a bridge, not a thickness)
+      f.thickness_min = std::min(f.thickness_min, t);
+      f.thickness_max = std::max(f.thickness_max, t);
+    }
+    if (f.thickness_min > f.thickness_max) f.thickness_min = f.thickness_max = 0;
   }
-  if (f.thickness_min > f.thickness_max) f.thickness_min = f.thickness_max = 0;
+  if (ctx.cancelled()) return Error{Status::cancelled, "cancelled"};
   ctx.progress("check", 0.3);
 
   // Collisions, in print order.
   Deposit dep(lo - Vec2(cp.block_radius + 1, cp.block_radius + 1),
               hi + Vec2(cp.block_radius + 1, cp.block_radius + 1), 0.2);
-  for (const PrintMove& m : moves) {
+  for (std::size_t mi = 0; mi < moves.size(); ++mi) {
+    const PrintMove& m = moves[mi];
+    if ((mi & 0xffff) == 0 && ctx.cancelled()) return Error{Status::cancelled, "cancelled"};
     if (!m.extruding || m.layer < 0) continue;
     const double len = (m.to - m.from).norm();
     const int n = std::max(1, static_cast<int>(std::ceil(len / 0.2)));
@@ -216,17 +274,19 @@ Expected<CheckFigures> check_print(const std::vector<PrintMove>& moves, const Tr
     }
   }
   ctx.progress("check", 0.6);
-  if (!mesh) return f;
+  if (!mesh || !grid) return f;
+  if (ctx.cancelled()) return Error{Status::cancelled, "cancelled"};
+  const std::vector<Pt>& all = grid->points();
 
   // Volume and extrusion outside the mesh.
   f.volume_ratio = filament * M_PI * 0.25 * cp.filament_diameter * cp.filament_diameter /
                    std::max(signed_volume(*mesh), 1e-12);
   const ColumnCaster cols(*mesh);
   std::size_t outside = 0, tested = 0;
-  for (std::size_t k = 0; k < pts.size(); k += 2) {
+  for (std::size_t k = 0; k < all.size(); k += 2) {
     ++tested;
     // The bead lies under the nozzle: test a quarter layer below the nozzle tip.
-    if (!cols.inside(pts[k].p.x(), pts[k].p.y(), pts[k].p.z() - 0.25 * cp.layer_height)) ++outside;
+    if (!cols.inside(all[k].p.x(), all[k].p.y(), all[k].p.z() - 0.25 * cp.layer_height)) ++outside;
   }
   f.outside_fraction = tested ? static_cast<double>(outside) / static_cast<double>(tested) : 0.0;
 
@@ -245,12 +305,9 @@ Expected<CheckFigures> check_print(const std::vector<PrintMove>& moves, const Tr
         const Vec3 s = a + (i + 1.0 / 3.0) / m * (b - a) + (j + 1.0 / 3.0) / m * (c - a);
         ++f.surface_samples;
         // The highest layer whose extrusion covers this XY within half a line width.
-        int top = -1;
-        grid.near(s.x(), s.y(), [&](const Pt& q) {
-          if ((q.p.head<2>() - s.head<2>()).norm() <= 0.225 + 0.1 && q.layer > top) top = q.layer;
-        });
+        const int top = grid->top_layer(s.x(), s.y(), 0.225 + 0.1);
         double z = 0;
-        if (top < 0 || !plane_z(grid, top, s.x(), s.y(), &z)) continue;
+        if (top < 0 || !plane_z(*grid, top, s.x(), s.y(), &z)) continue;
         ++f.covered_samples;
         dev.push_back(std::abs(z - s.z()));
       }

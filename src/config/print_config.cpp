@@ -87,6 +87,8 @@ Expected<bool> set_config_value(PrintConfig& c, const std::string& key, const st
   };
   if (key == "layer_height") return num(c.slice.layer_height);
   if (key == "first_layer_height") return pct(c.slice.first_layer_height, c.slice.layer_height);
+  if (key == "min_layer_height") return num(c.min_layer_height);
+  if (key == "max_layer_height") return num(c.max_layer_height);
   if (key == "nozzle_diameter") return num(t.nozzle_diameter);
   if (key == "filament_diameter") return num(g.filament_diameter);
   if (key == "extrusion_multiplier") return num(g.extrusion_multiplier);
@@ -192,6 +194,17 @@ Expected<bool> validate_config(const PrintConfig& c) {
   if (!pos(t.nozzle_diameter)) return bad("nozzle_diameter", "must be a finite number > 0");
   if (c.slice.layer_height > t.nozzle_diameter)
     return bad("layer_height", "is larger than the nozzle diameter");
+  for (const auto& [k, v] : {std::pair{"min_layer_height", c.min_layer_height},
+                             {"max_layer_height", c.max_layer_height}})
+    if (!std::isfinite(v) || v < 0) return bad(k, "must be a finite number >= 0 (0: automatic)");
+  if (c.min_layer_height > 0 && c.max_layer_height > 0 && c.min_layer_height > c.max_layer_height)
+    return bad("min_layer_height", "is above max_layer_height");
+  if (c.min_layer_height > c.slice.layer_height)
+    return bad("min_layer_height", "is above layer_height");
+  if (c.max_layer_height > 0 && c.max_layer_height < c.slice.layer_height)
+    return bad("max_layer_height", "is below layer_height");
+  if (c.max_layer_height > t.nozzle_diameter)
+    return bad("max_layer_height", "is larger than the nozzle diameter");
   if (!pos(g.filament_diameter)) return bad("filament_diameter", "must be a finite number > 0");
   if (!pos(g.extrusion_multiplier)) return bad("extrusion_multiplier", "must be > 0");
   for (const auto& [k, v] : {std::pair{"extrusion_width", t.extrusion_width},

@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <atomic>
 #include <cerrno>
 #include <cstring>
 #include <fstream>
@@ -9,6 +10,27 @@
 #include <system_error>
 
 namespace nonplanar {
+namespace {
+// The temporary being written, for remove_pending_temporary_file(). A fixed buffer, published
+// through an atomic flag, because a signal handler may read it at any moment.
+char g_pending[4096];
+std::atomic<bool> g_pending_set{false};
+
+struct PendingGuard {
+  explicit PendingGuard(const std::string& path) {
+    if (path.size() >= sizeof g_pending) return;  // too long to register: not removable early
+    std::memcpy(g_pending, path.c_str(), path.size() + 1);
+    g_pending_set.store(true);
+  }
+  ~PendingGuard() { g_pending_set.store(false); }
+  PendingGuard(const PendingGuard&) = delete;
+  PendingGuard& operator=(const PendingGuard&) = delete;
+};
+}  // namespace
+
+void remove_pending_temporary_file() {
+  if (g_pending_set.load()) ::unlink(g_pending);
+}
 
 Expected<bool> write_file_atomically(const std::filesystem::path& file,
                                      const std::function<bool(std::ostream&)>& write) {
@@ -22,6 +44,7 @@ Expected<bool> write_file_atomically(const std::filesystem::path& file,
   const fs::path tmp = dir / ("." + file.filename().string() + ".tmp" + std::to_string(::getpid()) +
                               "_" + std::to_string(rd() & 0xffffff));
   bool ok = false;
+  const PendingGuard pending(tmp.string());
   {
     std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
     if (!out)

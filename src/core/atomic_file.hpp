@@ -16,4 +16,8 @@ namespace nonplanar {
 Expected<bool> write_file_atomically(const std::filesystem::path& file,
                                      const std::function<bool(std::ostream&)>& write);
 
+/// Removes the temporary file a write_file_atomically call in progress is writing, if any.
+/// Async-signal-safe (one unlink): for a signal handler that is about to _exit.
+void remove_pending_temporary_file();
+
 }  // namespace nonplanar

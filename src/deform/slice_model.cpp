@@ -16,9 +16,13 @@ SliceJob make_job(const PrintConfig& print, double max_angle_deg) {
   j.layers.layer_height = print.slice.layer_height;
   j.layers.first_layer_height = print.slice.first_layer_height;
   j.layers.max_angle_deg = max_angle_deg;
-  j.layers.min_layer_height = std::min(j.analysis.min_layer_height, print.slice.layer_height);
-  j.layers.max_layer_height =
-      std::max(1.5 * print.slice.layer_height, std::min(0.75 * print.paths.nozzle_diameter, 0.3));
+  j.layers.min_layer_height = print.min_layer_height > 0
+                                  ? print.min_layer_height
+                                  : std::min(j.analysis.min_layer_height, print.slice.layer_height);
+  j.layers.max_layer_height = print.max_layer_height > 0
+                                  ? print.max_layer_height
+                                  : std::max(1.5 * print.slice.layer_height,
+                                             std::min(0.75 * print.paths.nozzle_diameter, 0.3));
   j.analysis.min_layer_height = j.layers.min_layer_height;
   return j;
 }
@@ -32,6 +36,13 @@ Expected<SliceResult> attempt(const TriangleMesh& mesh, const SliceJob& job,
   *offender = -1;
   SliceResult r;
   r.header.push_back(std::string("mode: ") + (job.planar_only ? "planar" : "non-planar"));
+  if (!job.planar_only) {
+    char buf[160];
+    std::snprintf(
+        buf, sizeof buf, "curved layers: h_min %.3f mm, h_max %.3f mm, max_angle %.1f deg",
+        job.layers.min_layer_height, job.layers.max_layer_height, job.layers.max_angle_deg);
+    r.header.push_back(buf);
+  }
   const TriangleMesh* to_slice = &mesh;
   TriangleMesh normalized;
   if (!job.planar_only) {
@@ -68,6 +79,22 @@ Expected<SliceResult> attempt(const TriangleMesh& mesh, const SliceJob& job,
   if (!sliced) return sliced.error();
   auto paths = make_toolpaths(*sliced, job.print.paths, ctx);
   if (!paths) return paths.error();
+  // A part thinner than one extrusion slices to nothing: say so rather than write G-code
+  // that only draws a skirt.
+  const bool prints = std::any_of(paths->begin(), paths->end(), [](const LayerToolpaths& L) {
+    return std::any_of(L.paths.begin(), L.paths.end(), [](const ExtrusionPath& p) {
+      return p.role != ExtrusionRole::skirt && p.points.size() >= 2;
+    });
+  });
+  if (!prints) {
+    const BoundingBox b = bounding_box(mesh);
+    char buf[200];
+    std::snprintf(buf, sizeof buf,
+                  "nothing to print: the part (%.2f x %.2f x %.2f mm) is smaller than one "
+                  "extrusion",
+                  b.size().x(), b.size().y(), b.size().z());
+    return Error{Status::invalid_mesh, buf};
+  }
   if (!r.nonplanar) {
     r.layers = std::move(*paths);
   } else {
@@ -128,6 +155,7 @@ Expected<SliceResult> attempt(const TriangleMesh& mesh, const SliceJob& job,
   cp.block_radius = L.block_radius;
   cp.block_clearance = L.block_clearance;
   cp.filament_diameter = job.print.gcode.filament_diameter;
+  cp.collisions_only = true;
   auto figures = check_print(moves_from_toolpaths(r.layers, job.print.gcode), nullptr, cp, ctx);
   if (!figures) return figures.error();
   r.collisions = figures->collisions;

@@ -63,7 +63,7 @@ std::string expand(std::string t, const PrintConfig& c) {
 
 class Emitter {
  public:
-  Emitter(const PrintConfig& c) : c_(c), g_(c.gcode) {}
+  explicit Emitter(const PrintConfig& c) : g_(c.gcode) {}
   std::string out;
 
   void raw(const std::string& s) { out += s; }
@@ -152,7 +152,6 @@ class Emitter {
     e_ += de;
     line("G1 E%.5f F%d ; %s", g_.relative_e ? de : e_, static_cast<int>(speed * 60), what);
   }
-  const PrintConfig& c_;
   const GcodeParams& g_;
   Vec3 pos_ = Vec3::Zero();
   bool have_pos_ = false, retracted_ = false;
@@ -229,10 +228,13 @@ Expected<bool> write_gcode_file(const std::filesystem::path& file,
                                 const std::vector<std::string>& header, const Context& ctx) {
   auto text = make_gcode(layers, c, header, ctx);
   if (!text) return text.error();
-  return write_file_atomically(file, [&](std::ostream& out) {
+  // Cancelled while writing: the writer removes its temporary, and no file appears.
+  auto w = write_file_atomically(file, [&](std::ostream& out) {
     out.write(text->data(), static_cast<std::streamsize>(text->size()));
-    return bool(out);
+    return bool(out) && !ctx.cancelled();
   });
+  if (!w && ctx.cancelled()) return Error{Status::cancelled, "cancelled"};
+  return w;
 }
 
 }  // namespace nonplanar

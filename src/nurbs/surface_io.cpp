@@ -85,9 +85,14 @@ Expected<bool> write_surfaces_json(const std::filesystem::path& file,
 Expected<std::vector<SurfaceRecord>> parse_surfaces_json(std::string_view text) {
   const auto j = nlohmann::json::parse(text.begin(), text.end(), nullptr, false);
   if (j.is_discarded()) return Error{Status::parse_error, "not valid JSON"};
-  if (!j.is_object() || j.value("format", "") != "nonplanar-surfaces")
+  // (json::value() throws when the key holds another type: test the types first. Found by
+  // fuzz_surfaces with {"format": 1111}.)
+  const auto format = j.is_object() ? j.find("format") : j.end();
+  if (format == j.end() || !format->is_string() || *format != "nonplanar-surfaces")
     return Error{Status::parse_error, "not a nonplanar-surfaces document"};
-  if (j.value("version", 0) != 1) return Error{Status::unsupported, "unknown version"};
+  const auto version = j.find("version");
+  if (version == j.end() || !version->is_number_integer() || *version != 1)
+    return Error{Status::unsupported, "unknown version"};
   std::vector<SurfaceRecord> out;
   try {
     for (const auto& s : j.at("surfaces")) {

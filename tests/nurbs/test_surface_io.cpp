@@ -49,6 +49,14 @@ TEST(SurfaceIo, RejectsMalformedDocuments) {
   auto type = parse_surfaces_json(
       R"({"format":"nonplanar-surfaces","version":1,"surfaces":[{"patch":"x"}]})");
   ASSERT_FALSE(type);
+  // Wrong types in the header are errors, not exceptions (fuzz_surfaces found the first).
+  const auto num = parse_surfaces_json(R"({"format":1111188888888888000000000000110})");
+  ASSERT_FALSE(num);
+  EXPECT_EQ(num.error().status, Status::parse_error);
+  const auto ver = parse_surfaces_json(R"({"format":"nonplanar-surfaces","version":"1"})");
+  ASSERT_FALSE(ver);
+  EXPECT_EQ(ver.error().status, Status::unsupported);
+  EXPECT_FALSE(parse_surfaces_json(R"([{"format":"nonplanar-surfaces"}])"));
 }
 
 TEST(SurfaceIo, ObjTessellationHasOneGridPerSurface) {

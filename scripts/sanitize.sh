@@ -1,0 +1,22 @@
+#!/usr/bin/env bash
+# The whole test suite under AddressSanitizer + UndefinedBehaviorSanitizer, built with clang-14
+# into build-san/ (which also holds the libFuzzer targets that fuzz/run.sh runs).
+# Any sanitizer report fails the test that triggered it.
+# Environment: BUILD_DIR (default build-san); CI=true turns warnings into errors.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bash scripts/setup.sh --with-clang
+build_dir=${BUILD_DIR:-build-san}
+werror=OFF
+[[ "${CI:-}" == "true" ]] && werror=ON
+generator=()
+command -v ninja >/dev/null && [[ ! -f "$build_dir/CMakeCache.txt" ]] && generator=(-G Ninja)
+# RelWithDebInfo: optimised enough that the pipeline tests finish, with line numbers in reports.
+CXX=clang++-14 cmake -S . -B "$build_dir" "${generator[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  -DNONPLANAR_FUZZ=ON -DNONPLANAR_BUILD_BENCH=OFF -DNONPLANAR_WERROR="$werror" >/dev/null
+cmake --build "$build_dir" -j"$(nproc)"
+export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=1:strict_string_checks=1}
+export LSAN_OPTIONS=${LSAN_OPTIONS:-suppressions=$PWD/scripts/lsan.supp:print_suppressions=0}
+export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
+cd "$build_dir"
+ctest --output-on-failure -j"$(nproc)" --timeout 1200

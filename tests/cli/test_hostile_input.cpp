@@ -1,0 +1,219 @@
+// Hostile input and faults, as a user meets them through the CLI: every bad_* model and
+// broken files made here end in exit 2 with one line naming the file, or in G-code that
+// `check` accepts; never a signal, a hang or a file left behind. Ctrl-C leaves nothing.
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdint>
+#include <nlohmann/json.hpp>
+#include <random>
+#include <thread>
+
+#include "support/files.hpp"
+#include "support/solids.hpp"
+
+extern char** environ;
+
+namespace nonplanar {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct CliRun {
+  int code;  ///< exit code, or 128 + signal
+  std::string err;
+};
+
+// Runs the CLI with a time limit; a run that needs longer is killed and reported as a hang.
+CliRun cli(const std::string& args, int limit_s = 300) {
+  const auto dir = test::temp_dir("hostile_run");
+  const std::string cmd = "timeout -s KILL " + std::to_string(limit_s) + " " + NONPLANAR_CLI + " " +
+                          args + " >/dev/null 2>" + (dir / "err").string();
+  const int status = std::system(cmd.c_str());
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status),
+          test::read_bytes(dir / "err")};
+}
+
+std::size_t lines(const std::string& s) {
+  return static_cast<std::size_t>(std::count(s.begin(), s.end(), '\n'));
+}
+
+// Files in `dir` (hidden ones too): what a failed or interrupted run must not leave.
+std::vector<std::string> listing(const fs::path& dir) {
+  std::vector<std::string> names;
+  for (const auto& e : fs::directory_iterator(dir)) names.push_back(e.path().filename().string());
+  return names;
+}
+
+// The outcome every input must have: exit 2 with one error line naming the file and no
+// output, or exit 0 with G-code that `check` reads and finds safe.
+void expect_clean_outcome(const fs::path& model, const std::string& what) {
+  const fs::path out_dir = test::temp_dir("hostile_out");
+  const fs::path out = out_dir / "out.gcode";
+  const CliRun a = cli("analyze -q " + model.string());
+  EXPECT_TRUE(a.code == 0 || a.code == 2) << what << ": analyze exit " << a.code << "\n" << a.err;
+  const CliRun s = cli("slice -q " + model.string() + " -o " + out.string());
+  ASSERT_TRUE(s.code == 0 || s.code == 2) << what << ": slice exit " << s.code << "\n" << s.err;
+  if (s.code == 2) {
+    EXPECT_EQ(lines(s.err), 1u) << what << ": " << s.err;
+    EXPECT_NE(s.err.find(model.filename().string()), std::string::npos) << what << ": " << s.err;
+    EXPECT_TRUE(listing(out_dir).empty()) << what << ": a failed run left a file";
+    return;
+  }
+  EXPECT_EQ(listing(out_dir), std::vector<std::string>{"out.gcode"}) << what;
+  const fs::path report = out_dir / "check.json";
+  const std::string cmd = std::string(NONPLANAR_CLI) + " check --json " + out.string() +
+                          " --mesh " + model.string() + " >" + report.string() + " 2>/dev/null";
+  ASSERT_EQ(std::system(cmd.c_str()), 0) << what << ": check refused our G-code";
+  const auto j = nlohmann::json::parse(test::read_bytes(report));
+  EXPECT_EQ(j["collisions"], 0) << what;
+  EXPECT_LE(j["steepest_extrusion"].get<double>(), 30.5) << what;
+  EXPECT_GT(j["extrusion_points"].get<std::size_t>(), 0u) << what;
+}
+
+TEST(HostileInput, EverySharedBadModelEndsCleanly) {
+  const fs::path dir = test::shared_models();
+  if (dir.empty()) GTEST_SKIP() << "../shared/models not present";
+  int n = 0;
+  for (const auto& e : fs::directory_iterator(dir)) {
+    if (e.path().filename().string().rfind("bad_", 0) != 0) continue;
+    expect_clean_outcome(e.path(), e.path().filename().string());
+    ++n;
+  }
+  EXPECT_GE(n, 12);
+}
+
+TEST(HostileInput, BrokenFilesEndCleanly) {
+  const fs::path dir = test::temp_dir("hostile_files");
+  std::mt19937 rng(20261123);
+  std::string noise(4096, '\0');
+  for (char& c : noise) c = static_cast<char>(rng() & 0xff);
+  for (const char* ext : {"stl", "obj", "off", "3mf"}) {
+    const fs::path f = dir / (std::string("noise.") + ext);
+    test::write_bytes(f, noise);
+    expect_clean_outcome(f, f.filename().string());
+  }
+  // A binary STL that claims 2^31 triangles but holds one.
+  std::string stl(80, ' ');
+  const std::uint32_t count = 1u << 31;
+  stl.append(reinterpret_cast<const char*>(&count), 4);
+  stl.append(50, '\0');
+  test::write_bytes(dir / "claims_2e31.stl", stl);
+  expect_clean_outcome(dir / "claims_2e31.stl", "2^31 triangle count");
+  const CliRun huge = cli("analyze " + (dir / "claims_2e31.stl").string());
+  EXPECT_EQ(huge.code, 2);
+  // An OBJ face index out of range, a zip that is not a 3MF, a lone triangle, an empty file.
+  test::write_bytes(dir / "index.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 7\n");
+  expect_clean_outcome(dir / "index.obj", "OBJ index out of range");
+  EXPECT_NE(cli("analyze " + (dir / "index.obj").string()).err.find("line 4"), std::string::npos);
+  const fs::path zip_dir = test::temp_dir("hostile_zip");
+  test::write_bytes(zip_dir / "readme.txt", "not a model\n");
+  ASSERT_EQ(std::system(("cd " + zip_dir.string() + " && zip -q " + (dir / "notes.3mf").string() +
+                         " readme.txt")
+                            .c_str()),
+            0);
+  expect_clean_outcome(dir / "notes.3mf", "zip that is not a 3MF");
+  test::write_bytes(dir / "one.obj", "v 0 0 0\nv 10 0 0\nv 0 10 0\nf 1 2 3\n");
+  expect_clean_outcome(dir / "one.obj", "single triangle");
+  test::write_bytes(dir / "empty.stl", "");
+  expect_clean_outcome(dir / "empty.stl", "empty file");
+  // A part below one extrusion: an error that says why, not G-code with only a skirt.
+  ASSERT_TRUE(write_stl(dir / "speck.stl", test::box({0, 0, 0}, {0.2, 0.2, 0.1})));
+  const CliRun speck =
+      cli("slice -q " + (dir / "speck.stl").string() + " -o " + (dir / "speck.gcode").string());
+  EXPECT_EQ(speck.code, 2);
+  EXPECT_NE(speck.err.find("nothing to print"), std::string::npos) << speck.err;
+}
+
+TEST(HostileInput, LimitsAreErrorsNamingTheKeyOrSizes) {
+  const fs::path dir = test::temp_dir("hostile_limits");
+  ASSERT_TRUE(write_stl(dir / "c.stl", test::box({0, 0, 0}, {250, 30, 10})));
+  const std::string model = (dir / "c.stl").string(), out = (dir / "c.gcode").string();
+  // Larger than the default 220 x 220 mm bed: both sizes in the message.
+  const CliRun bed = cli("slice -q " + model + " -o " + out);
+  EXPECT_EQ(bed.code, 2);
+  EXPECT_NE(bed.err.find("250.0"), std::string::npos) << bed.err;
+  EXPECT_NE(bed.err.find("220.0"), std::string::npos) << bed.err;
+  ASSERT_TRUE(write_stl(dir / "s.stl", test::box({0, 0, 0}, {20, 20, 5})));
+  const std::string small = (dir / "s.stl").string();
+  const std::pair<const char*, const char*> cases[] = {
+      {"--layer-height nan", "layer_height"},
+      {"--layer-height -0.1", "layer_height"},
+      {"--first-layer-height -1", "first_layer_height"},
+      {"--set retract_length=inf", "retract_length"},
+      {"--max-angle 90", "max_angle"},
+      {"--max-angle 120", "max_angle"},
+      {"--min-layer-height 0.15 --max-layer-height 0.12", "min_layer_height"},
+      {"--max-layer-height -0.3", "max_layer_height"},
+      {"--min-layer-height 0.3", "min_layer_height"},
+  };
+  for (const auto& [args, key] : cases) {
+    const CliRun r = cli("slice -q " + small + " -o " + out + " " + args);
+    EXPECT_EQ(r.code, 2) << args;
+    EXPECT_EQ(lines(r.err), 1u) << args << ": " << r.err;
+    EXPECT_NE(r.err.find(key), std::string::npos) << args << ": " << r.err;
+    EXPECT_FALSE(fs::exists(out)) << args;
+  }
+  // The same keys from a profile name the file and line.
+  test::write_bytes(dir / "p.ini", "layer_height = 0.2\nmin_layer_height = 0.25\n");
+  const CliRun ini =
+      cli("slice -q " + small + " -o " + out + " --config " + (dir / "p.ini").string());
+  EXPECT_EQ(ini.code, 2);
+  EXPECT_NE(ini.err.find("min_layer_height"), std::string::npos) << ini.err;
+  // h_min and h_max from the profile reach the curved layers.
+  ASSERT_TRUE(write_stl(
+      dir / "roof.stl",
+      test::height_field_solid([](double x, double) { return 8 + std::sin(2 * M_PI * x / 25); }, 0,
+                               50, 0, 30, 100, 40)));
+  const CliRun ok = cli("slice -q " + (dir / "roof.stl").string() + " -o " + out +
+                        " --min-layer-height 0.12 --max-layer-height 0.28");
+  ASSERT_EQ(ok.code, 0) << ok.err;
+  const std::string g = test::read_bytes(out);
+  EXPECT_NE(g.find("h_min 0.120"), std::string::npos);
+}
+
+// Ctrl-C at several moments of a long slice (the bunny takes about 10 s here): the run ends
+// promptly with 130, says so, and the output folder is left empty.
+TEST(HostileInput, InterruptLeavesNoFiles) {
+  const fs::path models = test::shared_models();
+  if (models.empty()) GTEST_SKIP() << "../shared/models not present";
+  const std::string model = (models / "np_stanford_bunny_closed_compas.stl").string();
+  for (const double delay : {0.2, 1.0, 2.5}) {
+    const fs::path dir = test::temp_dir("hostile_sigint");
+    const fs::path log = test::temp_dir("hostile_sigint_log") / "err";
+    const std::string out = (dir / "bunny.gcode").string();
+    std::vector<std::string> args = {NONPLANAR_CLI, "slice", "-q", model, "-o", out};
+    std::vector<char*> argv;
+    for (auto& a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    posix_spawn_file_actions_t fa;
+    posix_spawn_file_actions_init(&fa);
+    posix_spawn_file_actions_addopen(&fa, STDERR_FILENO, log.c_str(), O_WRONLY | O_CREAT, 0644);
+    pid_t pid = 0;
+    ASSERT_EQ(posix_spawn(&pid, NONPLANAR_CLI, &fa, nullptr, argv.data(), environ), 0);
+    posix_spawn_file_actions_destroy(&fa);
+    std::this_thread::sleep_for(std::chrono::duration<double>(delay));
+    ::kill(pid, SIGINT);
+    const auto t0 = std::chrono::steady_clock::now();
+    int status = 0;
+    // A CLI that ignored the signal would hang here until the test's timeout.
+    ASSERT_EQ(::waitpid(pid, &status, 0), pid);
+    const double waited =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    ASSERT_TRUE(WIFEXITED(status)) << "killed by signal " << WTERMSIG(status);
+    EXPECT_EQ(WEXITSTATUS(status), 130) << "delay " << delay;
+    EXPECT_NE(test::read_bytes(log).find("interrupted"), std::string::npos);
+    const auto left = listing(dir);
+    EXPECT_TRUE(left.empty()) << "delay " << delay << ": left " << left.front();
+    // Prompt: every stage checks the flag (generous for sanitizer builds on a shared machine).
+    EXPECT_LT(waited, 30.0) << "delay " << delay;
+  }
+}
+
+}  // namespace
+}  // namespace nonplanar
