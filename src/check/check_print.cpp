@@ -153,11 +153,19 @@ class Deposit {
     c.current = std::max(c.current, p.z());
     double& b = block_[static_cast<std::size_t>(i / kBlock) * by_ + j / kBlock];
     b = std::max(b, p.z());
+    if (layer > top_layer_)
+      top_earlier_ = std::max(top_earlier_, top_current_), top_current_ = -1e300,
+      top_layer_ = layer;
+    top_current_ = std::max(top_current_, p.z());
   }
   // Does earlier layers' material enter the nozzle at p deeper than `depth`? A block is
   // skipped unless its highest point clears the smallest allowance anywhere in it (the cone
   // at the block's nearest distance, or the heater block).
   bool collides(const Vec3& p, int layer, const CheckParams& cp, double tan_a, double depth) const {
+    // Nothing deposited reaches above p: no allowance can be negative, so no collision.
+    // (Every layer printed above all earlier material, i.e. most of any part, stops here.)
+    const double top = layer == top_layer_ ? top_earlier_ : std::max(top_earlier_, top_current_);
+    if (top <= p.z() + depth) return false;
     const double R = cp.block_radius, R2 = R * R;
     const int i0 = ix(p.x() - R), i1 = ix(p.x() + R), j0 = iy(p.y() - R), j1 = iy(p.y() + R);
     for (int bi = std::max(0, i0 / kBlock); bi <= std::min(bx_ - 1, i1 / kBlock); ++bi)
@@ -199,6 +207,9 @@ class Deposit {
   Vec2 lo_;
   double cell_;
   int nx_ = 0, ny_ = 0, bx_ = 0, by_ = 0;
+  // Highest material of the layers before the newest one, and of the newest one.
+  double top_earlier_ = -1e300, top_current_ = -1e300;
+  int top_layer_ = -1;
   std::vector<Cell> cells_;
   std::vector<double> block_;
 };
@@ -222,18 +233,18 @@ Expected<CheckFigures> check_print(const std::vector<PrintMove>& moves, const Tr
     const double len = (m.to - m.from).norm();
     // Every 0.2 mm: the coverage test below allows half of that beyond half a line width.
     const int n = std::max(1, static_cast<int>(std::ceil(len / 0.2)));
-    for (int k = 1; k <= n; ++k) {
-      const Pt q{m.from + (m.to - m.from) * (static_cast<double>(k) / n), m.layer};
-      pts.push_back(q);
-      lo = lo.cwiseMin(q.p.head<2>()), hi = hi.cwiseMax(q.p.head<2>());
-    }
+    lo = lo.cwiseMin(m.from.head<2>().cwiseMin(m.to.head<2>()));
+    hi = hi.cwiseMax(m.from.head<2>().cwiseMax(m.to.head<2>()));
+    f.extrusions += static_cast<std::size_t>(n);
+    if (!cp.collisions_only)
+      for (int k = 1; k <= n; ++k)
+        pts.push_back({m.from + (m.to - m.from) * (static_cast<double>(k) / n), m.layer});
     const double dxy = (m.to.head<2>() - m.from.head<2>()).norm();
     if (dxy > 0.05)
       f.steepest_deg =
           std::max(f.steepest_deg, std::atan2(std::abs(m.to.z() - m.from.z()), dxy) * 180 / M_PI);
   }
-  f.extrusions = pts.size();
-  if (pts.empty()) return f;
+  if (f.extrusions == 0) return f;
   if (ctx.cancelled()) return Error{Status::cancelled, "cancelled"};
 
   // Thickness: height above the previous layer's extrusions there (first layer: the bed).
