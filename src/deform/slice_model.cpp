@@ -32,7 +32,8 @@ namespace {
 // One attempt with the patches not in `excluded`. On a limit violation inside a curved band,
 // *offender is set to that band's patch (the caller retries without it).
 Expected<SliceResult> attempt(const TriangleMesh& mesh, const SliceJob& job,
-                              const std::vector<int>& excluded, int* offender, const Context& ctx) {
+                              const std::vector<int>& excluded, int* offender, std::string* why,
+                              const Context& ctx) {
   *offender = -1;
   SliceResult r;
   r.header.push_back(std::string("mode: ") + (job.planar_only ? "planar" : "non-planar"));
@@ -119,11 +120,11 @@ Expected<SliceResult> attempt(const TriangleMesh& mesh, const SliceJob& job,
     return best;
   };
   auto violation = [&](const Vec3& p, const char* what) -> Expected<SliceResult> {
-    if (r.nonplanar && (*offender = band_at(p)) >= 0) return r;  // the caller retries
     char buf[240];
-    std::snprintf(buf, sizeof buf, "safety check: %s at (%.2f, %.2f, %.2f)", what, p.x(), p.y(),
-                  p.z());
-    return Error{Status::internal_error, buf};
+    std::snprintf(buf, sizeof buf, "%s at (%.2f, %.2f, %.2f)", what, p.x(), p.y(), p.z());
+    *why = buf;
+    if (r.nonplanar && (*offender = band_at(p)) >= 0) return r;  // the caller retries
+    return Error{Status::internal_error, std::string("safety check: ") + buf};
   };
   r.thickness_min = 1e300, r.thickness_max = 0;
   const double tan_max = std::tan((L.max_angle_deg + 0.5) * M_PI / 180.0);
@@ -172,7 +173,8 @@ Expected<SliceResult> slice_model(const TriangleMesh& mesh, const SliceJob& job,
   std::vector<std::string> dropped;
   for (int round = 0; round < 8; ++round) {
     int offender = -1;
-    auto r = attempt(mesh, job, excluded, &offender, ctx);
+    std::string why;
+    auto r = attempt(mesh, job, excluded, &offender, &why, ctx);
     if (!r) return r;
     if (offender < 0) {
       r->notices.insert(r->notices.begin(), dropped.begin(), dropped.end());
@@ -181,8 +183,8 @@ Expected<SliceResult> slice_model(const TriangleMesh& mesh, const SliceJob& job,
     // A stack that met every limit on its own grid broke one in the final paths: print
     // that patch planar rather than refuse the part.
     excluded.push_back(offender);
-    dropped.push_back("patch " + std::to_string(offender) +
-                      " printed planar: its final paths broke a printer limit");
+    dropped.push_back("patch " + std::to_string(offender) + " printed planar: in its final paths " +
+                      why);
   }
   return Error{Status::internal_error, "safety check: still failing after dropping 8 patches"};
 }

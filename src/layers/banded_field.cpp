@@ -45,7 +45,7 @@ Band::Basis Band::basis(double x, double y) const {
   return b;
 }
 
-double Band::surface(const Basis& b, int i) const {
+double Band::raw_surface(const Basis& b, int i) const {
   const NurbsSurface& s = top.surface;
   double z = 0;
   for (int a = 0; a <= s.p; ++a) {
@@ -53,6 +53,19 @@ double Band::surface(const Basis& b, int i) const {
     for (int c2 = 0; c2 <= s.q; ++c2) z += b.R[a * (s.q + 1) + c2] * Z(i, row + c2);
   }
   return z;
+}
+
+double Band::surface(const Basis& b, int i) const {
+  const double z = raw_surface(b, i);
+  if (top_lo >= top_hi || i == N) return z;
+  const double z0 = i == 0 ? z : raw_surface(b, 0);
+  if (z0 >= top_lo && z0 <= top_hi) return z;
+  // Off the patch the top swings out of its range: clamp it, and scale the stack under it
+  // so its layers keep their proportions (they stay ordered and between h_min and h_max as
+  // on the patch). A top that fell to the plane leaves no proportions: split evenly.
+  const double t0 = std::clamp(z0, top_lo, top_hi);
+  if (z0 - c < 0.5 * (top_lo - c)) return c + (t0 - c) * (N - i) / N;
+  return c + (z - c) * (t0 - c) / (z0 - c);
 }
 
 void Band::heights(double x, double y, double* S) const {

@@ -23,6 +23,10 @@ struct Band {
   double c = 0, T_bottom = 0;
   int N = 0;
   double fade = 1.0;  ///< L_rec, mm
+  /// Range of the top S_0 over the patch (empty when top_lo >= top_hi: no clamp). Off the
+  /// patch the fit is held only by its smoothness term and can swing; there S_0 is clamped
+  /// to this range and the layers under it scaled alike, so the blend zone sees a tame stack.
+  double top_lo = 0, top_hi = 0;
   // β: cubic B-spline control values on a grid (origin = node (0, 0)).
   Vec2 blend_origin{0, 0};
   double blend_cell = 0.5;
@@ -35,8 +39,10 @@ struct Band {
     double R[64];
   };
   Basis basis(double x, double y) const;
-  /// S_i at the basis's point.
+  /// S_i at the basis's point (off the patch: tamed, see top_lo).
   double surface(const Basis& b, int i) const;
+  /// S_i as the control heights give it.
+  double raw_surface(const Basis& b, int i) const;
   /// S_0 … S_N at (x, y) into S (size N + 1).
   void heights(double x, double y, double* S) const;
   double beta(double x, double y) const;

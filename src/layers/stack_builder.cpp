@@ -296,10 +296,17 @@ StackResult build_stack(const TriangleMesh& mesh, const Patch& patch, int patch_
   b.c = st.c;
   b.N = N;
   b.T_bottom = st.T_bottom;
+  // The top's range over the patch bounds it elsewhere (see Band::top_lo); a hair of slack
+  // so points between grid samples on the patch are never touched.
+  b.top_lo = 1e300, b.top_hi = -1e300;
+  for (int kk = 0; kk < n; ++kk)
+    if (grid.on_patch[kk])
+      b.top_lo = std::min(b.top_lo, top_z[kk]), b.top_hi = std::max(b.top_hi, top_z[kk]);
+  b.top_lo -= 0.01, b.top_hi += 0.01;
   // How far the curved layers sit from the planar ones decides how gently they blend.
   double dev = 0;
   for (int kk = 0; kk < n; ++kk)
-    dev = std::max(dev, std::abs(top_z[kk] - (st.c + N * p.layer_height)));
+    if (grid.on_patch[kk]) dev = std::max(dev, std::abs(top_z[kk] - (st.c + N * p.layer_height)));
   b.fade = std::max(1.0, 4.5 * dev);
   const double blend = std::max(2.0, 1.3 * 1.5 * dev / std::tan(p.max_angle_deg * kDeg));
   const PatchRaster wide =
