@@ -34,6 +34,7 @@ struct LayerToolpaths {
   std::vector<ExtrusionPath> paths;  ///< in print order
   bool nonplanar = false;            ///< some point leaves the plane z (travels must lift)
   double max_z = 0;                  ///< highest point of the layer (travel clearance)
+  double max_slope = 0;              ///< steepest |dz| / dxy of its paths (short-hop clearance)
 };
 
 /// Builds the paths of every layer from its islands. Errors: invalid_argument, cancelled.

@@ -78,8 +78,14 @@ Expected<std::vector<LayerToolpaths>> map_toolpaths_back(const std::vector<Layer
         emit(field, p.points[k - 1], prev, p.points[k], cur, p.height[k], params.tolerance, 0, q);
         prev = cur;
       }
-      for (const Vec3& v : q.points)
+      for (std::size_t k = 0; k < q.points.size(); ++k) {
+        const Vec3& v = q.points[k];
         M.max_z = std::max(M.max_z, v.z()), min_z = std::min(min_z, v.z());
+        if (k == 0) continue;
+        const double dxy = (v - q.points[k - 1]).head<2>().norm();
+        if (dxy > 1e-3)
+          M.max_slope = std::max(M.max_slope, std::abs(v.z() - q.points[k - 1].z()) / dxy);
+      }
       M.paths.push_back(std::move(q));
     }
     M.nonplanar = M.max_z - min_z > 1e-6;

@@ -19,6 +19,8 @@ double filament_per_mm(double width, double height, const GcodeParams& g) {
 }
 
 namespace {
+// Radius of the nozzle's flat tip (LayerParams::nozzle_tip_radius): what a hop must clear.
+constexpr double kTipRadius = 0.4;
 
 const char* flavor_name(GcodeFlavor f) {
   switch (f) {
@@ -99,13 +101,23 @@ class Emitter {
   // Travel to p: lift and retract for long moves, never through the part at print height.
   // On a curved layer, material printed so far lies below the layer's highest point, so a
   // travel rises above that (plus a clearance), moves, then descends.
-  void travel(const Vec3& p, double speed, bool curved, double safe_z) {
+  //
+  // A short hop (≤ 0.6 mm, as between neighbouring infill lines) only rises above what the
+  // layer can hold within reach of it: the layer is no steeper than `slope`, so nothing of
+  // it within the nozzle's tip radius r of the hop stands higher than its ends by more than
+  // slope · (d / 2 + r). (Travelling at the ends' height went 0.12 mm under a neighbouring
+  // line on a wave; TravelsClearPrintedMaterial found it.)
+  void travel(const Vec3& p, double speed, bool curved, double safe_z, double slope) {
     if (curved && have_pos_) {
       const double d = (p.head<2>() - pos_.head<2>()).norm();
       if (d < 1e-6 && std::abs(p.z() - pos_.z()) < 1e-6) return;
-      if (d > 0.6 || std::abs(p.z() - pos_.z()) > 0.1) {
+      const double hop = slope * (0.5 * d + kTipRadius);
+      if (d > 0.6 || std::abs(p.z() - pos_.z()) > 0.1 || hop > 0.05) {
         if (d > g_.retract_before_travel) retract();
-        const double lift = std::max({safe_z, pos_.z(), p.z()}) + std::max(0.3, g_.retract_lift);
+        const double lift =
+            d > 0.6 || std::abs(p.z() - pos_.z()) > 0.1
+                ? std::max({safe_z, pos_.z(), p.z()}) + std::max(0.3, g_.retract_lift)
+                : std::max(pos_.z(), p.z()) + hop + 0.05;
         line("G1 Z%.3f F%d", lift, static_cast<int>(speed * 60));
         line("G1 X%.3f Y%.3f F%d", p.x(), p.y(), static_cast<int>(speed * 60));
         line("G1 Z%.3f F%d", p.z(), static_cast<int>(speed * 60));
@@ -197,7 +209,7 @@ Expected<std::string> make_gcode(const std::vector<LayerToolpaths>& layers, cons
     bool first = true;
     for (const ExtrusionPath& p : L.paths) {
       if (p.points.size() < 2) continue;
-      em.travel(p.points.front(), c.paths.travel_speed, L.nonplanar, L.max_z);
+      em.travel(p.points.front(), c.paths.travel_speed, L.nonplanar, L.max_z, L.max_slope);
       if (first || p.role != role) em.line(";TYPE:%s", role_name(p.role));
       if (first || std::abs(p.width - width) > 1e-9) em.line(";WIDTH:%.3f", p.width);
       first = false;

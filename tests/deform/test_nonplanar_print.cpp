@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <map>
 
 #include "nonplanar/gcode.hpp"
 #include "nonplanar/io.hpp"
@@ -75,6 +76,52 @@ TEST(NonplanarPrint, SineRoofAtFullInfillKeepsItsVolume) {
           c);
   expect_good(o, 1);
   EXPECT_NEAR(o.figures.volume_ratio, 1.0, 0.03);
+}
+
+// Travels never pass through printed material: along every travel, no earlier extrusion
+// within the nozzle tip's radius stands higher than the nozzle by more than h / 2 (the
+// collision depth of DESIGN.md §3). Curved layers put lower and higher material side by
+// side, so an unlifted travel over a wave would fail this.
+TEST(NonplanarPrint, TravelsClearPrintedMaterial) {
+  const Outcome o = run(test::height_field_solid(
+      [](double x, double) { return 8 + 1.5 * std::sin(2 * M_PI * x / 25); }, 0, 50, 0, 30, 150,
+      60));
+  expect_good(o, 1);
+  auto moves = read_gcode_moves(o.gcode);
+  ASSERT_TRUE(moves);
+  // Extrusion samples every 0.2 mm, binned in 1 mm cells.
+  std::map<std::pair<int, int>, std::vector<Vec3>> deposit;
+  auto cell = [](double v) { return static_cast<int>(std::floor(v)); };
+  std::size_t travels = 0, lifted = 0;
+  for (const PrintMove& m : *moves) {
+    const double len = (m.to - m.from).head<2>().norm();
+    const int n = std::max(1, static_cast<int>(std::ceil(len / 0.2)));
+    if (m.extruding) {
+      for (int k = 0; k <= n; ++k) {
+        const Vec3 p = m.from + (m.to - m.from) * (static_cast<double>(k) / n);
+        deposit[{cell(p.x()), cell(p.y())}].push_back(p);
+      }
+      continue;
+    }
+    if (m.filament != 0 || len < 1e-6 || m.layer < 0) continue;
+    ++travels;
+    lifted += m.from.z() > 8 + 1.5 + 0.2;  // above the whole roof
+    for (int k = 0; k <= n; ++k) {
+      const Vec3 p = m.from + (m.to - m.from) * (static_cast<double>(k) / n);
+      for (int a = cell(p.x()) - 1; a <= cell(p.x()) + 1; ++a)
+        for (int b = cell(p.y()) - 1; b <= cell(p.y()) + 1; ++b) {
+          const auto it = deposit.find({a, b});
+          if (it == deposit.end()) continue;
+          for (const Vec3& q : it->second) {
+            if ((q - p).head<2>().norm() > 0.4) continue;
+            ASSERT_LE(q.z() - p.z(), 0.1) << "travel at line " << m.line << " through material at ("
+                                          << q.x() << ", " << q.y() << ", " << q.z() << ")";
+          }
+        }
+    }
+  }
+  EXPECT_GT(travels, 100u);
+  EXPECT_GT(lifted, 10u);  // the curved top layers' travels went over the roof
 }
 
 TEST(NonplanarPrint, TwoCurvedTowers) {
