@@ -42,6 +42,7 @@ Band::Basis Band::basis(double x, double y) const {
       W += r;
     }
   for (int k = 0; k < (s.p + 1) * (s.q + 1); ++k) b.R[k] /= W;
+  b.top = raw_surface(b, 0);
   return b;
 }
 
@@ -58,7 +59,7 @@ double Band::raw_surface(const Basis& b, int i) const {
 double Band::surface(const Basis& b, int i) const {
   const double z = raw_surface(b, i);
   if (top_lo >= top_hi || i == N) return z;
-  const double z0 = i == 0 ? z : raw_surface(b, 0);
+  const double z0 = b.top;
   if (z0 >= top_lo && z0 <= top_hi) return z;
   // Off the patch the top swings out of its range: clamp it, and scale the stack under it
   // so its layers keep their proportions (they stay ordered and between h_min and h_max as

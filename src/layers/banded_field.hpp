@@ -37,6 +37,7 @@ struct Band {
   struct Basis {
     int i0 = 0, j0 = 0;
     double R[64];
+    double top = 0;  ///< raw S_0 here (surface() tames the others by it)
   };
   Basis basis(double x, double y) const;
   /// S_i at the basis's point (off the patch: tamed, see top_lo).
