@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <optional>
 
 #include "nonplanar/deform.hpp"
 #include "nonplanar/pipeline.hpp"
@@ -30,11 +31,20 @@ SliceJob make_job(const PrintConfig& print, double max_angle_deg) {
 namespace {
 
 // One attempt with the patches not in `excluded`. On a limit violation inside a curved band,
-// *offender is set to that band's patch (the caller retries without it).
-Expected<SliceResult> attempt(const TriangleMesh& mesh, const SliceJob& job,
-                              const std::vector<int>& excluded, int* offender, std::string* why,
+// every such band's patch and what it broke are added to *offenders (the caller retries
+// without them; all thickness and slope offenders of one attempt are found at once).
+// Analysis and fitted surfaces: computed once, shared by every attempt.
+struct Prepared {
+  Analysis analysis;
+  std::vector<SurfaceFit> fits;
+  std::vector<int> ids;  ///< patch of each fit
+};
+
+Expected<SliceResult> attempt(const TriangleMesh& mesh, const SliceJob& job, const Prepared& pre,
+                              const std::vector<int>& excluded,
+                              std::vector<std::pair<int, std::string>>* offenders,
                               const Context& ctx) {
-  *offender = -1;
+  offenders->clear();
   SliceResult r;
   r.header.push_back(std::string("mode: ") + (job.planar_only ? "planar" : "non-planar"));
   if (!job.planar_only) {
@@ -47,12 +57,14 @@ Expected<SliceResult> attempt(const TriangleMesh& mesh, const SliceJob& job,
   const TriangleMesh* to_slice = &mesh;
   TriangleMesh normalized;
   if (!job.planar_only) {
-    auto a = analyze(mesh, job.analysis, ctx);
-    if (!a) return a.error();
+    // The surfaces of the patches not excluded (analysis and fits do not depend on which).
+    const Analysis* a = &pre.analysis;
+    std::vector<SurfaceFit> fits;
     std::vector<int> ids;
-    auto fits = fit_patches(mesh, *a, job.fit, excluded, &ids, ctx);
-    if (!fits) return fits.error();
-    auto plan = plan_layers(mesh, *a, *fits, ids, job.layers, ctx);
+    for (std::size_t i = 0; i < pre.ids.size(); ++i)
+      if (std::find(excluded.begin(), excluded.end(), pre.ids[i]) == excluded.end())
+        fits.push_back(pre.fits[i]), ids.push_back(pre.ids[i]);
+    auto plan = plan_layers(mesh, *a, fits, ids, job.layers, ctx);
     if (!plan) return plan.error();
     r.plan = std::move(*plan);
     for (const auto& fb : r.plan.fallbacks)
@@ -119,12 +131,21 @@ Expected<SliceResult> attempt(const TriangleMesh& mesh, const SliceJob& job,
     }
     return best;
   };
-  auto violation = [&](const Vec3& p, const char* what) -> Expected<SliceResult> {
+  // A violation in a curved band marks that band (true: go on looking); elsewhere it is a
+  // bug, reported as an error.
+  std::optional<Error> fatal;
+  auto violation = [&](const Vec3& p, const char* what) {
     char buf[240];
     std::snprintf(buf, sizeof buf, "%s at (%.2f, %.2f, %.2f)", what, p.x(), p.y(), p.z());
-    *why = buf;
-    if (r.nonplanar && (*offender = band_at(p)) >= 0) return r;  // the caller retries
-    return Error{Status::internal_error, std::string("safety check: ") + buf};
+    const int band = r.nonplanar ? band_at(p) : -1;
+    if (band < 0) {
+      fatal = Error{Status::internal_error, std::string("safety check: ") + buf};
+      return false;
+    }
+    for (const auto& o : *offenders)
+      if (o.first == band) return true;
+    offenders->emplace_back(band, buf);
+    return true;
   };
   r.thickness_min = 1e300, r.thickness_max = 0;
   const double tan_max = std::tan((L.max_angle_deg + 0.5) * M_PI / 180.0);
@@ -135,17 +156,21 @@ Expected<SliceResult> attempt(const TriangleMesh& mesh, const SliceJob& job,
         if (li > 0) {
           r.thickness_min = std::min(r.thickness_min, p.height[k]);
           r.thickness_max = std::max(r.thickness_max, p.height[k]);
-          if (p.height[k] < L.min_layer_height - 1e-3 || p.height[k] > L.max_layer_height + 1e-3)
-            return violation(p.points[k], "a layer leaves the thickness limits");
+          if ((p.height[k] < L.min_layer_height - 1e-3 ||
+               p.height[k] > L.max_layer_height + 1e-3) &&
+              !violation(p.points[k], "a layer leaves the thickness limits"))
+            return *fatal;
         }
         if (k == 0) continue;
         const double dxy = (p.points[k] - p.points[k - 1]).head<2>().norm();
         const double dz = std::abs(p.points[k].z() - p.points[k - 1].z());
         if (dxy > 0.05) r.steepest_deg = std::max(r.steepest_deg, std::atan2(dz, dxy) * 180 / M_PI);
-        if (dxy > 0.05 && dz > tan_max * dxy)
-          return violation(p.points[k], "an extrusion is steeper than max_angle");
+        if (dxy > 0.05 && dz > tan_max * dxy &&
+            !violation(p.points[k], "an extrusion is steeper than max_angle"))
+          return *fatal;
       }
     }
+  if (!offenders->empty()) return r;  // the caller retries without them
   if (r.thickness_min > r.thickness_max) r.thickness_min = r.thickness_max = 0;
   if (!r.nonplanar) return r;  // planar layers cannot dig into earlier ones
   CheckParams cp;
@@ -161,7 +186,8 @@ Expected<SliceResult> attempt(const TriangleMesh& mesh, const SliceJob& job,
   if (!figures) return figures.error();
   r.collisions = figures->collisions;
   if (figures->collisions > 0)
-    return violation(figures->first_collision, "an extrusion would hit earlier layers");
+    for (const Vec3& p : figures->collision_points)
+      if (!violation(p, "an extrusion would hit earlier layers")) return *fatal;
   return r;
 }
 
@@ -169,22 +195,32 @@ Expected<SliceResult> attempt(const TriangleMesh& mesh, const SliceJob& job,
 
 Expected<SliceResult> slice_model(const TriangleMesh& mesh, const SliceJob& job,
                                   const Context& ctx) {
+  Prepared pre;
+  if (!job.planar_only) {
+    auto a = analyze(mesh, job.analysis, ctx);
+    if (!a) return a.error();
+    pre.analysis = std::move(*a);
+    auto fits = fit_patches(mesh, pre.analysis, job.fit, {}, &pre.ids, ctx);
+    if (!fits) return fits.error();
+    pre.fits = std::move(*fits);
+  }
   std::vector<int> excluded;
   std::vector<std::string> dropped;
+  std::vector<std::pair<int, std::string>> offenders;
   for (int round = 0; round < 8; ++round) {
-    int offender = -1;
-    std::string why;
-    auto r = attempt(mesh, job, excluded, &offender, &why, ctx);
+    auto r = attempt(mesh, job, pre, excluded, &offenders, ctx);
     if (!r) return r;
-    if (offender < 0) {
+    if (offenders.empty()) {
       r->notices.insert(r->notices.begin(), dropped.begin(), dropped.end());
       return r;
     }
     // A stack that met every limit on its own grid broke one in the final paths: print
     // that patch planar rather than refuse the part.
-    excluded.push_back(offender);
-    dropped.push_back("patch " + std::to_string(offender) + " printed planar: in its final paths " +
-                      why);
+    for (const auto& [patch, why] : offenders) {
+      excluded.push_back(patch);
+      dropped.push_back("patch " + std::to_string(patch) + " printed planar: in its final paths " +
+                        why);
+    }
   }
   return Error{Status::internal_error, "safety check: still failing after dropping 8 patches"};
 }
