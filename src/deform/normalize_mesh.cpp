@@ -1,3 +1,5 @@
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -26,31 +28,40 @@ Expected<NormalizedMesh> normalize_mesh(const TriangleMesh& mesh, const LayerFie
   NormalizedMesh out;
   TriangleMesh m = mesh;
   std::vector<Vec3> image(m.vertices.size());
-  for (std::size_t v = 0; v < m.vertices.size(); ++v) image[v] = mapped(field, m.vertices[v]);
+  // Field evaluations are the cost (a root-find in blend zones): in parallel, then the
+  // bookkeeping in order, so the result does not depend on the thread count.
+  tbb::parallel_for(std::size_t{0}, m.vertices.size(),
+                    [&](std::size_t v) { image[v] = mapped(field, m.vertices[v]); });
 
   for (int round = 0; round < params.max_rounds; ++round) {
     if (ctx.cancelled()) return Error{Status::cancelled, "cancelled"};
     // Decide per edge once; the midpoint index is shared by both faces (conforming).
     std::unordered_map<std::uint64_t, int> mid;
     mid.reserve(m.faces.size());
+    std::vector<std::pair<int, int>> edges;  // each edge once, in face order
     for (const auto& f : m.faces)
       for (int k = 0; k < 3; ++k) {
         const int a = f[k], b = f[(k + 1) % 3];
-        const std::uint64_t key = edge_key(a, b);
-        if (mid.count(key)) continue;
-        const Vec3 pm = 0.5 * (m.vertices[a] + m.vertices[b]);
-        const Vec3 im = mapped(field, pm);
-        // Long edges in a curved region are split regardless: a midpoint on the chord does
-        // not prove the whole edge maps straight.
-        const bool long_curved = im.z() != pm.z() && (m.vertices[a] - m.vertices[b]).norm() > 2.0;
-        if (!long_curved && (im - 0.5 * (image[a] + image[b])).norm() <= params.tolerance) {
-          mid.emplace(key, -1);
-          continue;
-        }
-        mid.emplace(key, static_cast<int>(m.vertices.size()));
-        m.vertices.push_back(pm);
-        image.push_back(im);
+        if (mid.emplace(edge_key(a, b), -1).second) edges.emplace_back(a, b);
       }
+    std::vector<Vec3> im(edges.size());
+    std::vector<char> split_it(edges.size());
+    tbb::parallel_for(std::size_t{0}, edges.size(), [&](std::size_t e) {
+      const auto [a, b] = edges[e];
+      const Vec3 pm = 0.5 * (m.vertices[a] + m.vertices[b]);
+      im[e] = mapped(field, pm);
+      // Long edges in a curved region are split regardless: a midpoint on the chord does
+      // not prove the whole edge maps straight.
+      const bool long_curved = im[e].z() != pm.z() && (m.vertices[a] - m.vertices[b]).norm() > 2.0;
+      split_it[e] = long_curved || (im[e] - 0.5 * (image[a] + image[b])).norm() > params.tolerance;
+    });
+    for (std::size_t e = 0; e < edges.size(); ++e) {
+      if (!split_it[e]) continue;
+      const auto [a, b] = edges[e];
+      mid[edge_key(a, b)] = static_cast<int>(m.vertices.size());
+      m.vertices.push_back(0.5 * (m.vertices[a] + m.vertices[b]));
+      image.push_back(im[e]);
+    }
     std::size_t split = 0;
     std::vector<std::array<int, 3>> faces;
     faces.reserve(m.faces.size());

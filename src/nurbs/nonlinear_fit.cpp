@@ -171,7 +171,9 @@ NonlinearReport levenberg_marquardt(NurbsSurface& s, const SampleBasis& b,
   opts.max_num_iterations = params.max_iterations;
   opts.num_threads = 2;
   opts.logging_type = ceres::SILENT;
-  opts.function_tolerance = 1e-10;
+  // Stop when an iteration gains less than 0.01 % of the cost: on FoilCutter the last 41 of
+  // 50 iterations (0.18 s) moved the RMS by 0.04 µm.
+  opts.function_tolerance = 1e-4;
   ceres::Solver::Summary summary;
   ceres::Solve(opts, &problem, &summary);
   NonlinearReport rep;
