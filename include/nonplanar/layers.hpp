@@ -78,6 +78,28 @@ Expected<LayerPlan> plan_layers(const TriangleMesh& mesh, const Analysis& analys
                                 const std::vector<int>& patch_of_fit, const LayerParams& params,
                                 const Context& ctx);
 
+/// Stacks plan_layers has built, by patch, for a caller that plans the same mesh, fits and
+/// parameters again with fewer patches (the pipeline's retries): a stack depends only on
+/// its own patch, so it is built once. Opaque; only valid for the inputs it was filled with.
+class StackCache {
+ public:
+  StackCache();
+  ~StackCache();
+  StackCache(const StackCache&) = delete;
+  StackCache& operator=(const StackCache&) = delete;
+  struct Impl;
+  Impl& impl() { return *impl_; }
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
+
+/// plan_layers, reusing and filling `cache`.
+Expected<LayerPlan> plan_layers(const TriangleMesh& mesh, const Analysis& analysis,
+                                const std::vector<SurfaceFit>& fits,
+                                const std::vector<int>& patch_of_fit, const LayerParams& params,
+                                StackCache& cache, const Context& ctx);
+
 /// The layer field T over the whole part: planar (ζ = z) outside the curved bands, each band
 /// blended C² into the planar layers around it; strictly increasing in z.
 class LayerField {

@@ -37,7 +37,8 @@ namespace {
 struct Prepared {
   Analysis analysis;
   std::vector<SurfaceFit> fits;
-  std::vector<int> ids;  ///< patch of each fit
+  std::vector<int> ids;       ///< patch of each fit
+  mutable StackCache stacks;  ///< each patch's stack is built once across the attempts
 };
 
 Expected<SliceResult> attempt(const TriangleMesh& mesh, const SliceJob& job, const Prepared& pre,
@@ -64,7 +65,7 @@ Expected<SliceResult> attempt(const TriangleMesh& mesh, const SliceJob& job, con
     for (std::size_t i = 0; i < pre.ids.size(); ++i)
       if (std::find(excluded.begin(), excluded.end(), pre.ids[i]) == excluded.end())
         fits.push_back(pre.fits[i]), ids.push_back(pre.ids[i]);
-    auto plan = plan_layers(mesh, *a, fits, ids, job.layers, ctx);
+    auto plan = plan_layers(mesh, *a, fits, ids, job.layers, pre.stacks, ctx);
     if (!plan) return plan.error();
     r.plan = std::move(*plan);
     for (const auto& fb : r.plan.fallbacks)

@@ -119,10 +119,24 @@ std::shared_ptr<const LayerField> planar_field(const LayerParams& p) {
                                        std::vector<Band>{});
 }
 
+struct StackCache::Impl {
+  std::map<int, layers::StackResult> built;  ///< by patch
+};
+StackCache::StackCache() : impl_(std::make_unique<Impl>()) {}
+StackCache::~StackCache() = default;
+
 Expected<LayerPlan> plan_layers(const TriangleMesh& mesh, const Analysis& analysis,
                                 const std::vector<SurfaceFit>& fits,
                                 const std::vector<int>& patch_of_fit, const LayerParams& params,
                                 const Context& ctx) {
+  StackCache cache;
+  return plan_layers(mesh, analysis, fits, patch_of_fit, params, cache, ctx);
+}
+
+Expected<LayerPlan> plan_layers(const TriangleMesh& mesh, const Analysis& analysis,
+                                const std::vector<SurfaceFit>& fits,
+                                const std::vector<int>& patch_of_fit, const LayerParams& params,
+                                StackCache& cache, const Context& ctx) {
   if (auto e = check(params)) return *e;
   if (fits.size() != patch_of_fit.size())
     return Error{Status::invalid_argument, "plan_layers: one patch index per fit expected"};
@@ -135,8 +149,14 @@ Expected<LayerPlan> plan_layers(const TriangleMesh& mesh, const Analysis& analys
     const int pid = patch_of_fit[i];
     if (pid < 0 || pid >= static_cast<int>(analysis.patches.size()))
       return Error{Status::invalid_argument, "plan_layers: patch index out of range"};
-    auto r = layers::build_stack(mesh, analysis.patches[pid], pid, fits[i].surface, columns, params,
-                                 planar);
+    auto& built = cache.impl().built;
+    auto it = built.find(pid);
+    if (it == built.end())
+      it = built
+               .emplace(pid, layers::build_stack(mesh, analysis.patches[pid], pid, fits[i].surface,
+                                                 columns, params, planar))
+               .first;
+    layers::StackResult r = it->second;
     if (!r.failure.empty()) {
       plan.fallbacks.push_back({pid, r.failure});
     } else {
