@@ -133,6 +133,34 @@ TEST(Layers, TwoTowersGetTwoStacksInOneField) {
   for (double z = 0.1; z < 22; z += 0.3) EXPECT_NEAR(F.zeta(F.T(40, 20, z)), z, 1e-12);
 }
 
+// The pipeline's retries plan again with a patch left out; the stacks they share come from
+// the cache and are the same as planned from scratch, and the left-out patch is gone.
+TEST(Layers, StackCacheGivesTheSamePlanWithFewerPatches) {
+  Planned p = plan_for(towers());
+  ASSERT_EQ(p.fits.size(), 2u);
+  StackCache cache;
+  const LayerParams lp;
+  auto both = plan_layers(p.mesh, p.analysis, p.fits, p.ids, lp, cache, {});
+  ASSERT_TRUE(both);
+  ASSERT_EQ(both->stacks.size(), 2u);
+  auto one = plan_layers(p.mesh, p.analysis, {p.fits[1]}, {p.ids[1]}, lp, cache, {});
+  auto fresh = plan_layers(p.mesh, p.analysis, {p.fits[1]}, {p.ids[1]}, lp, {});
+  ASSERT_TRUE(one && fresh);
+  ASSERT_EQ(one->stacks.size(), 1u);
+  ASSERT_EQ(fresh->stacks.size(), 1u);
+  EXPECT_EQ(one->stacks[0].patch, p.ids[1]);
+  EXPECT_EQ(one->stacks[0].layers, fresh->stacks[0].layers);
+  EXPECT_EQ(one->stacks[0].c, fresh->stacks[0].c);
+  EXPECT_EQ(one->stacks[0].thickness_min, fresh->stacks[0].thickness_min);
+  EXPECT_EQ(one->stacks[0].cost_after, fresh->stacks[0].cost_after);
+  // The tower left out is planar in the cached plan's field.
+  const Vec2 c0 = 0.5 * (both->stacks[0].xy_min + both->stacks[0].xy_max);
+  const Vec2 c1 = 0.5 * (both->stacks[1].xy_min + both->stacks[1].xy_max);
+  const Vec2 out = both->stacks[0].patch == p.ids[1] ? c1 : c0;
+  EXPECT_TRUE(one->field->planar_at(out.x(), out.y()));
+  EXPECT_FALSE(both->field->planar_at(out.x(), out.y()));
+}
+
 TEST(Layers, OptimiserLowersTheCostOfAPoorStart) {
   const TriangleMesh m = sine_roof();
   const Analysis a = *analyze(m, {}, {});
