@@ -57,7 +57,7 @@ struct CheckFigures {
   std::size_t collisions = 0;
   Vec3 first_collision{0, 0, 0};
   int first_collision_line = 0;
-  std::vector<Vec3> collision_points;  ///< where (the first 4096), for callers that locate them
+  std::vector<Vec3> collision_points;  ///< where (≤ 4096, ≥ 1 mm apart), to locate them
   double volume_ratio = 0;             ///< extruded volume (skirt excluded) / mesh volume
   double outside_fraction = 0;         ///< extrusion points outside the mesh (skirt excluded)
   std::size_t extrusions = 0;

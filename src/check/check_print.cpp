@@ -279,7 +279,10 @@ Expected<CheckFigures> check_print(const std::vector<PrintMove>& moves, const Tr
       const Vec3 p = m.from + (m.to - m.from) * (static_cast<double>(k) / n);
       if (dep.collides(p, m.layer, cp, tan_a, 0.5 * cp.layer_height)) {
         if (f.collisions == 0) f.first_collision = p, f.first_collision_line = m.line;
-        if (f.collision_points.size() < 4096) f.collision_points.push_back(p);
+        // Spread out (1 mm apart at least): one long collision must not fill the list.
+        if (f.collision_points.size() < 4096 &&
+            (f.collision_points.empty() || (f.collision_points.back() - p).norm() > 1.0))
+          f.collision_points.push_back(p);
         ++f.collisions;
       }
       dep.put(p, m.layer);

@@ -171,9 +171,10 @@ Expected<SliceResult> attempt(const TriangleMesh& mesh, const SliceJob& job, con
           return *fatal;
       }
     }
-  if (!offenders->empty()) return r;  // the caller retries without them
   if (r.thickness_min > r.thickness_max) r.thickness_min = r.thickness_max = 0;
   if (!r.nonplanar) return r;  // planar layers cannot dig into earlier ones
+  // Collisions are looked for even when bands already broke a limit, so one retry drops
+  // every offender (each retry replans, reslices and rechecks the whole part).
   CheckParams cp;
   cp.max_angle_deg = L.max_angle_deg;
   cp.layer_height = L.layer_height;
