@@ -45,21 +45,28 @@ int run(CheckOptions o) {
   finish_progress();
   if (!f) return report_error(f.error());
   if (o.json) {
-    nlohmann::ordered_json j = {{"gcode", o.gcode},
-                                {"mesh", o.mesh.model},
-                                {"top_surface_deviation",
-                                 {{"mean", f->deviation_mean},
-                                  {"p95", f->deviation_p95},
-                                  {"max", f->deviation_max},
-                                  {"samples", f->surface_samples},
-                                  {"covered_samples", f->covered_samples}}},
-                                {"thickness_min", f->thickness_min},
-                                {"thickness_max", f->thickness_max},
-                                {"steepest_extrusion", f->steepest_deg},
-                                {"collisions", f->collisions},
-                                {"volume_ratio", f->volume_ratio},
-                                {"outside_fraction", f->outside_fraction},
-                                {"extrusion_points", f->extrusions}};
+    nlohmann::ordered_json j = {
+        {"gcode", o.gcode},
+        {"mesh", o.mesh.model},
+        {"top_surface_deviation",
+         {{"mean", f->deviation_mean},
+          {"p95", f->deviation_p95},
+          {"max", f->deviation_max},
+          {"samples", f->surface_samples},
+          {"covered_samples", f->covered_samples}}},
+        {"thickness_min", f->thickness_min},
+        {"thickness_max", f->thickness_max},
+        {"steepest_extrusion", f->steepest_deg},
+        {"collisions", f->collisions},
+        {"first_collision", f->collisions == 0
+                                ? nlohmann::json(nullptr)
+                                : nlohmann::json{{"line", f->first_collision_line},
+                                                 {"at",
+                                                  {f->first_collision.x(), f->first_collision.y(),
+                                                   f->first_collision.z()}}}},
+        {"volume_ratio", f->volume_ratio},
+        {"outside_fraction", f->outside_fraction},
+        {"extrusion_points", f->extrusions}};
     std::printf("%s\n", j.dump(2).c_str());
     return kExitOk;
   }
@@ -70,7 +77,11 @@ int run(CheckOptions o) {
       f->surface_samples);
   std::printf("  layer thickness         %.3f - %.3f mm\n", f->thickness_min, f->thickness_max);
   std::printf("  steepest extrusion      %.1f deg\n", f->steepest_deg);
-  std::printf("  collisions              %zu\n", f->collisions);
+  std::printf("  collisions              %zu", f->collisions);
+  if (f->collisions > 0)
+    std::printf("  (first at line %d, x %.2f y %.2f z %.2f)", f->first_collision_line,
+                f->first_collision.x(), f->first_collision.y(), f->first_collision.z());
+  std::printf("\n");
   std::printf("  extruded / mesh volume  %.3f\n", f->volume_ratio);
   std::printf("  extrusion outside mesh  %.2f %%\n", 100 * f->outside_fraction);
   return kExitOk;

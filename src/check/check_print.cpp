@@ -134,84 +134,122 @@ bool plane_z(const PointGrid& g, int layer, double x, double y, double* z) {
 }
 
 // Heights of deposited material per cell, split into "earlier layers" and "this layer",
-// with coarse block maxima to skip cells that cannot collide.
+// with maxima over 4 × 4 and 16 × 16 cells to skip cells that cannot collide.
 class Deposit {
  public:
   Deposit(const Vec2& lo, const Vec2& hi, double cell) : lo_(lo), cell_(cell) {
     nx_ = static_cast<int>((hi.x() - lo.x()) / cell) + 2;
     ny_ = static_cast<int>((hi.y() - lo.y()) / cell) + 2;
     cells_.assign(static_cast<std::size_t>(nx_) * ny_, Cell{});
-    bx_ = nx_ / kBlock + 1, by_ = ny_ / kBlock + 1;
-    block_.assign(static_cast<std::size_t>(bx_) * by_, -1e300);
+    for (int l = 0; l < 2; ++l) {
+      lx_[l] = nx_ / kSize[l] + 1, ly_[l] = ny_ / kSize[l] + 1;
+      level_[l].assign(static_cast<std::size_t>(lx_[l]) * ly_[l], Cell{});
+    }
   }
   void put(const Vec3& p, int layer) {
     const int i = ix(p.x()), j = iy(p.y());
     if (i < 0 || j < 0 || i >= nx_ || j >= ny_) return;
-    Cell& c = cells_[static_cast<std::size_t>(i) * ny_ + j];
-    if (c.layer < layer)
-      c.earlier = std::max(c.earlier, c.current), c.current = -1e300, c.layer = layer;
-    c.current = std::max(c.current, p.z());
-    double& b = block_[static_cast<std::size_t>(i / kBlock) * by_ + j / kBlock];
-    b = std::max(b, p.z());
+    add(cells_[static_cast<std::size_t>(i) * ny_ + j], p.z(), layer);
+    for (int l = 0; l < 2; ++l)
+      add(level_[l][static_cast<std::size_t>(i / kSize[l]) * ly_[l] + j / kSize[l]], p.z(), layer);
     if (layer > top_layer_)
       top_earlier_ = std::max(top_earlier_, top_current_), top_current_ = -1e300,
       top_layer_ = layer;
     top_current_ = std::max(top_current_, p.z());
   }
-  // Does earlier layers' material enter the nozzle at p deeper than `depth`? A block is
-  // skipped unless its highest point clears the smallest allowance anywhere in it (the cone
-  // at the block's nearest distance, or the heater block).
+  // Does earlier layers' material enter the nozzle at p deeper than `depth`? A block (16 × 16
+  // cells, then 4 × 4) is skipped unless its highest point clears the smallest allowance
+  // anywhere in it (the cone at the block's nearest distance, or the heater block).
   bool collides(const Vec3& p, int layer, const CheckParams& cp, double tan_a, double depth) const {
     // Nothing deposited reaches above p: no allowance can be negative, so no collision.
     // (Every layer printed above all earlier material, i.e. most of any part, stops here.)
     const double top = layer == top_layer_ ? top_earlier_ : std::max(top_earlier_, top_current_);
     if (top <= p.z() + depth) return false;
-    const double R = cp.block_radius, R2 = R * R;
-    const int i0 = ix(p.x() - R), i1 = ix(p.x() + R), j0 = iy(p.y() - R), j1 = iy(p.y() + R);
-    for (int bi = std::max(0, i0 / kBlock); bi <= std::min(bx_ - 1, i1 / kBlock); ++bi)
-      for (int bj = std::max(0, j0 / kBlock); bj <= std::min(by_ - 1, j1 / kBlock); ++bj) {
-        const double bx0 = lo_.x() + bi * kBlock * cell_, by0 = lo_.y() + bj * kBlock * cell_;
-        const double dx = std::max({bx0 - p.x(), 0.0, p.x() - (bx0 + kBlock * cell_)});
-        const double dy = std::max({by0 - p.y(), 0.0, p.y() - (by0 + kBlock * cell_)});
-        const double dmin = std::sqrt(dx * dx + dy * dy);
-        if (dmin > R) continue;
-        const double allow =
-            std::min(std::max(0.0, dmin - cp.nozzle_tip_radius) * tan_a, cp.block_clearance);
-        if (block_[static_cast<std::size_t>(bi) * by_ + bj] <= p.z() + depth + allow) continue;
-        for (int i = std::max(i0, bi * kBlock); i <= std::min(i1, bi * kBlock + kBlock - 1); ++i)
-          for (int j = std::max(j0, bj * kBlock); j <= std::min(j1, bj * kBlock + kBlock - 1);
-               ++j) {
-            if (i < 0 || j < 0 || i >= nx_ || j >= ny_) continue;
-            const Cell& c = cells_[static_cast<std::size_t>(i) * ny_ + j];
-            const double z = c.layer < layer ? std::max(c.earlier, c.current) : c.earlier;
-            if (z <= p.z() + depth) continue;
-            const double ex = lo_.x() + (i + 0.5) * cell_ - p.x(),
-                         ey = lo_.y() + (j + 0.5) * cell_ - p.y();
-            const double d2 = ex * ex + ey * ey;
-            if (d2 > R2) continue;
-            const double cone = std::max(0.0, std::sqrt(d2) - cp.nozzle_tip_radius) * tan_a;
-            if (z - p.z() - std::min(cone, cp.block_clearance) > depth) return true;
-          }
-      }
-    return false;
+    const Query q{p,
+                  layer,
+                  cp,
+                  tan_a,
+                  depth,
+                  ix(p.x() - cp.block_radius),
+                  ix(p.x() + cp.block_radius),
+                  iy(p.y() - cp.block_radius),
+                  iy(p.y() + cp.block_radius)};
+    return search(q, 0, std::max(0, q.i0 / kSize[0]), std::min(lx_[0] - 1, q.i1 / kSize[0]),
+                  std::max(0, q.j0 / kSize[0]), std::min(ly_[0] - 1, q.j1 / kSize[0]));
   }
 
  private:
-  static constexpr int kBlock = 16;
+  static constexpr int kSize[2] = {16, 4};  // cells per block side, coarse then fine
   struct Cell {
     double earlier = -1e300, current = -1e300;
     int layer = -1;
   };
+  struct Query {
+    const Vec3& p;
+    int layer;
+    const CheckParams& cp;
+    double tan_a, depth;
+    int i0, i1, j0, j1;  ///< cell range within the block radius
+  };
+  static void add(Cell& c, double z, int layer) {
+    if (c.layer < layer)
+      c.earlier = std::max(c.earlier, c.current), c.current = -1e300, c.layer = layer;
+    c.current = std::max(c.current, z);
+  }
+  // Only earlier layers count: a curved layer's own material beside p is higher than p all
+  // along a slope, and would keep every block from being skipped.
+  static double earlier_z(const Cell& c, int layer) {
+    return c.layer < layer ? std::max(c.earlier, c.current) : c.earlier;
+  }
+  // Blocks [bi0, bi1] × [bj0, bj1] of level l (l = 2: cells).
+  bool search(const Query& q, int l, int bi0, int bi1, int bj0, int bj1) const {
+    const double R = q.cp.block_radius;
+    for (int bi = bi0; bi <= bi1; ++bi)
+      for (int bj = bj0; bj <= bj1; ++bj) {
+        if (l == 2) {
+          const double z = earlier_z(cells_[static_cast<std::size_t>(bi) * ny_ + bj], q.layer);
+          if (z <= q.p.z() + q.depth) continue;
+          const double ex = lo_.x() + (bi + 0.5) * cell_ - q.p.x(),
+                       ey = lo_.y() + (bj + 0.5) * cell_ - q.p.y();
+          const double d2 = ex * ex + ey * ey;
+          if (d2 > R * R) continue;
+          const double cone = std::max(0.0, std::sqrt(d2) - q.cp.nozzle_tip_radius) * q.tan_a;
+          if (z - q.p.z() - std::min(cone, q.cp.block_clearance) > q.depth) return true;
+          continue;
+        }
+        const int n = kSize[l];
+        const double bx0 = lo_.x() + bi * n * cell_, by0 = lo_.y() + bj * n * cell_;
+        const double dx = std::max({bx0 - q.p.x(), 0.0, q.p.x() - (bx0 + n * cell_)});
+        const double dy = std::max({by0 - q.p.y(), 0.0, q.p.y() - (by0 + n * cell_)});
+        const double dmin = std::sqrt(dx * dx + dy * dy);
+        if (dmin > R) continue;
+        const double allow =
+            std::min(std::max(0.0, dmin - q.cp.nozzle_tip_radius) * q.tan_a, q.cp.block_clearance);
+        const Cell& c = level_[l][static_cast<std::size_t>(bi) * ly_[l] + bj];
+        if (earlier_z(c, q.layer) <= q.p.z() + q.depth + allow) continue;
+        // The finer level's blocks (or the cells) inside this one, within the radius.
+        const int f = l == 0 ? kSize[0] / kSize[1] : kSize[1];
+        const int lo_i = bi * f, hi_i = bi * f + f - 1, lo_j = bj * f, hi_j = bj * f + f - 1;
+        const int ci0 = l == 0 ? q.i0 / kSize[1] : q.i0, ci1 = l == 0 ? q.i1 / kSize[1] : q.i1;
+        const int cj0 = l == 0 ? q.j0 / kSize[1] : q.j0, cj1 = l == 0 ? q.j1 / kSize[1] : q.j1;
+        const int nxl = l == 0 ? lx_[1] : nx_, nyl = l == 0 ? ly_[1] : ny_;
+        if (search(q, l + 1, std::max({lo_i, ci0, 0}), std::min({hi_i, ci1, nxl - 1}),
+                   std::max({lo_j, cj0, 0}), std::min({hi_j, cj1, nyl - 1})))
+          return true;
+      }
+    return false;
+  }
   int ix(double x) const { return static_cast<int>(std::floor((x - lo_.x()) / cell_)); }
   int iy(double y) const { return static_cast<int>(std::floor((y - lo_.y()) / cell_)); }
   Vec2 lo_;
   double cell_;
-  int nx_ = 0, ny_ = 0, bx_ = 0, by_ = 0;
+  int nx_ = 0, ny_ = 0;
+  int lx_[2] = {0, 0}, ly_[2] = {0, 0};
   // Highest material of the layers before the newest one, and of the newest one.
   double top_earlier_ = -1e300, top_current_ = -1e300;
   int top_layer_ = -1;
   std::vector<Cell> cells_;
-  std::vector<double> block_;
+  std::vector<Cell> level_[2];  ///< per block of each level, split like the cells
 };
 
 }  // namespace
@@ -277,7 +315,7 @@ Expected<CheckFigures> check_print(const std::vector<PrintMove>& moves, const Tr
     const int n = std::max(1, static_cast<int>(std::ceil(len / 0.2)));
     for (int k = 1; k <= n; ++k) {
       const Vec3 p = m.from + (m.to - m.from) * (static_cast<double>(k) / n);
-      if (dep.collides(p, m.layer, cp, tan_a, 0.5 * cp.layer_height)) {
+      if (dep.collides(p, m.layer, cp, tan_a, 0.5 * cp.layer_height - cp.collision_margin)) {
         if (f.collisions == 0) f.first_collision = p, f.first_collision_line = m.line;
         // Spread out (1 mm apart at least): one long collision must not fill the list.
         if (f.collision_points.size() < 4096 &&

@@ -184,6 +184,7 @@ Expected<SliceResult> attempt(const TriangleMesh& mesh, const SliceJob& job, con
   cp.block_clearance = L.block_clearance;
   cp.filament_diameter = job.print.gcode.filament_diameter;
   cp.collisions_only = true;
+  cp.collision_margin = 0.01;
   auto figures = check_print(moves_from_toolpaths(r.layers, job.print.gcode), nullptr, cp, ctx);
   if (!figures) return figures.error();
   r.collisions = figures->collisions;
