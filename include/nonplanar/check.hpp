@@ -44,9 +44,6 @@ struct CheckParams {
   /// Only steepest extrusion and collisions (the slicer's safety gate, which measures
   /// thickness from its own paths): thickness, volume and deviation are left at 0.
   bool collisions_only = false;
-  /// Subtracted from the collision depth h / 2, mm. The slicer's gate uses 0.01 so that
-  /// writing coordinates to 1 µm cannot tip a borderline point over in a later `check`.
-  double collision_margin = 0;
 };
 
 /// The figures of DESIGN.md §4. Deviation is vertical, mm; thickness is the height of each

@@ -315,7 +315,7 @@ Expected<CheckFigures> check_print(const std::vector<PrintMove>& moves, const Tr
     const int n = std::max(1, static_cast<int>(std::ceil(len / 0.2)));
     for (int k = 1; k <= n; ++k) {
       const Vec3 p = m.from + (m.to - m.from) * (static_cast<double>(k) / n);
-      if (dep.collides(p, m.layer, cp, tan_a, 0.5 * cp.layer_height - cp.collision_margin)) {
+      if (dep.collides(p, m.layer, cp, tan_a, 0.5 * cp.layer_height)) {
         if (f.collisions == 0) f.first_collision = p, f.first_collision_line = m.line;
         // Spread out (1 mm apart at least): one long collision must not fill the list.
         if (f.collision_points.size() < 4096 &&

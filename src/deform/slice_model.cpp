@@ -117,6 +117,12 @@ Expected<SliceResult> attempt(const TriangleMesh& mesh, const SliceJob& job, con
     r.layers = std::move(*mapped);
   }
 
+  // The G-code holds coordinates to 1 µm: check exactly what will be written, so `check`
+  // on the file agrees with this gate even for a point at the collision depth's edge.
+  for (LayerToolpaths& L : r.layers)
+    for (ExtrusionPath& p : L.paths)
+      for (Vec3& v : p.points) v = (v * 1000.0).array().round() / 1000.0;
+
   // Safety (DESIGN.md §3): thickness and slope from the paths themselves, collisions with
   // earlier layers from the independent check.
   const LayerParams& L = job.layers;
@@ -184,7 +190,6 @@ Expected<SliceResult> attempt(const TriangleMesh& mesh, const SliceJob& job, con
   cp.block_clearance = L.block_clearance;
   cp.filament_diameter = job.print.gcode.filament_diameter;
   cp.collisions_only = true;
-  cp.collision_margin = 0.01;
   auto figures = check_print(moves_from_toolpaths(r.layers, job.print.gcode), nullptr, cp, ctx);
   if (!figures) return figures.error();
   r.collisions = figures->collisions;
