@@ -141,7 +141,7 @@ class Deposit {
     nx_ = static_cast<int>((hi.x() - lo.x()) / cell) + 2;
     ny_ = static_cast<int>((hi.y() - lo.y()) / cell) + 2;
     cells_.assign(static_cast<std::size_t>(nx_) * ny_, Cell{});
-    for (int l = 0; l < 2; ++l) {
+    for (int l = 0; l < kLevels; ++l) {
       lx_[l] = nx_ / kSize[l] + 1, ly_[l] = ny_ / kSize[l] + 1;
       level_[l].assign(static_cast<std::size_t>(lx_[l]) * ly_[l], Cell{});
     }
@@ -150,16 +150,16 @@ class Deposit {
     const int i = ix(p.x()), j = iy(p.y());
     if (i < 0 || j < 0 || i >= nx_ || j >= ny_) return;
     add(cells_[static_cast<std::size_t>(i) * ny_ + j], p.z(), layer);
-    for (int l = 0; l < 2; ++l)
+    for (int l = 0; l < kLevels; ++l)
       add(level_[l][static_cast<std::size_t>(i / kSize[l]) * ly_[l] + j / kSize[l]], p.z(), layer);
     if (layer > top_layer_)
       top_earlier_ = std::max(top_earlier_, top_current_), top_current_ = -1e300,
       top_layer_ = layer;
     top_current_ = std::max(top_current_, p.z());
   }
-  // Does earlier layers' material enter the nozzle at p deeper than `depth`? A block (16 × 16
-  // cells, then 4 × 4) is skipped unless its highest point clears the smallest allowance
-  // anywhere in it (the cone at the block's nearest distance, or the heater block).
+  // Does earlier layers' material enter the nozzle at p deeper than `depth`? A block (64 × 64
+  // cells, then 16 × 16, then 4 × 4) is skipped unless its highest point clears the smallest
+  // allowance anywhere in it (the cone at the block's nearest distance, or the heater block).
   bool collides(const Vec3& p, int layer, const CheckParams& cp, double tan_a, double depth) const {
     // Nothing deposited reaches above p: no allowance can be negative, so no collision.
     // (Every layer printed above all earlier material, i.e. most of any part, stops here.)
@@ -179,7 +179,8 @@ class Deposit {
   }
 
  private:
-  static constexpr int kSize[2] = {16, 4};  // cells per block side, coarse then fine
+  static constexpr int kLevels = 3;
+  static constexpr int kSize[kLevels] = {64, 16, 4};  // cells per block side, coarse to fine
   struct Cell {
     double earlier = -1e300, current = -1e300;
     int layer = -1;
@@ -201,12 +202,12 @@ class Deposit {
   static double earlier_z(const Cell& c, int layer) {
     return c.layer < layer ? std::max(c.earlier, c.current) : c.earlier;
   }
-  // Blocks [bi0, bi1] × [bj0, bj1] of level l (l = 2: cells).
+  // Blocks [bi0, bi1] × [bj0, bj1] of level l (l = kLevels: cells).
   bool search(const Query& q, int l, int bi0, int bi1, int bj0, int bj1) const {
     const double R = q.cp.block_radius;
     for (int bi = bi0; bi <= bi1; ++bi)
       for (int bj = bj0; bj <= bj1; ++bj) {
-        if (l == 2) {
+        if (l == kLevels) {
           const double z = earlier_z(cells_[static_cast<std::size_t>(bi) * ny_ + bj], q.layer);
           if (z <= q.p.z() + q.depth) continue;
           const double ex = lo_.x() + (bi + 0.5) * cell_ - q.p.x(),
@@ -228,11 +229,12 @@ class Deposit {
         const Cell& c = level_[l][static_cast<std::size_t>(bi) * ly_[l] + bj];
         if (earlier_z(c, q.layer) <= q.p.z() + q.depth + allow) continue;
         // The finer level's blocks (or the cells) inside this one, within the radius.
-        const int f = l == 0 ? kSize[0] / kSize[1] : kSize[1];
+        const bool last = l + 1 == kLevels;
+        const int sub = last ? 1 : kSize[l + 1];  // cells per child block
+        const int f = n / sub;
         const int lo_i = bi * f, hi_i = bi * f + f - 1, lo_j = bj * f, hi_j = bj * f + f - 1;
-        const int ci0 = l == 0 ? q.i0 / kSize[1] : q.i0, ci1 = l == 0 ? q.i1 / kSize[1] : q.i1;
-        const int cj0 = l == 0 ? q.j0 / kSize[1] : q.j0, cj1 = l == 0 ? q.j1 / kSize[1] : q.j1;
-        const int nxl = l == 0 ? lx_[1] : nx_, nyl = l == 0 ? ly_[1] : ny_;
+        const int ci0 = q.i0 / sub, ci1 = q.i1 / sub, cj0 = q.j0 / sub, cj1 = q.j1 / sub;
+        const int nxl = last ? nx_ : lx_[l + 1], nyl = last ? ny_ : ly_[l + 1];
         if (search(q, l + 1, std::max({lo_i, ci0, 0}), std::min({hi_i, ci1, nxl - 1}),
                    std::max({lo_j, cj0, 0}), std::min({hi_j, cj1, nyl - 1})))
           return true;
@@ -244,12 +246,12 @@ class Deposit {
   Vec2 lo_;
   double cell_;
   int nx_ = 0, ny_ = 0;
-  int lx_[2] = {0, 0}, ly_[2] = {0, 0};
+  int lx_[kLevels] = {}, ly_[kLevels] = {};
   // Highest material of the layers before the newest one, and of the newest one.
   double top_earlier_ = -1e300, top_current_ = -1e300;
   int top_layer_ = -1;
   std::vector<Cell> cells_;
-  std::vector<Cell> level_[2];  ///< per block of each level, split like the cells
+  std::vector<Cell> level_[kLevels];  ///< per block of each level, split like the cells
 };
 
 }  // namespace
