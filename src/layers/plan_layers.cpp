@@ -1,5 +1,7 @@
 // plan_layers: stacks per patch, then the field, then a check of the blend zones inside the
 // material; a patch whose blend breaks a limit is dropped to planar and the field rebuilt.
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -67,13 +69,24 @@ std::string check_blend(const BandedField& field, const Band& b, const ColumnCas
     }
   if (cols.empty()) return {};
   const int k_hi = static_cast<int>(std::ceil(field.t_of_zeta(top_max + b.fade))) + 1;
-  for (const auto& [i, j] : cols) {
+  // Layer boundaries per column (root-finding: the cost of this check), in parallel; the
+  // verdicts below walk the columns in order, so the reported place does not depend on it.
+  std::vector<std::vector<double>> zc(cols.size());
+  std::vector<std::vector<std::pair<double, double>>> ivc(cols.size());
+  tbb::parallel_for(std::size_t{0}, cols.size(), [&](std::size_t c) {
+    const double x = b.blend_origin.x() + cols[c].first * b.blend_cell,
+                 y = b.blend_origin.y() + cols[c].second * b.blend_cell;
+    ivc[c] = columns.intervals(x, y);
+    if (ivc[c].empty()) return;
+    for (int k = static_cast<int>(T0); k <= k_hi; ++k) zc[c].push_back(field.z_at(x, y, k));
+  });
+  for (std::size_t c = 0; c < cols.size(); ++c) {
+    const auto [i, j] = cols[c];
     const double x = b.blend_origin.x() + i * b.blend_cell,
                  y = b.blend_origin.y() + j * b.blend_cell;
-    const auto iv = columns.intervals(x, y);
+    const auto& iv = ivc[c];
     if (iv.empty()) continue;
-    std::vector<double> z;
-    for (int k = static_cast<int>(T0); k <= k_hi; ++k) z.push_back(field.z_at(x, y, k));
+    std::vector<double>& z = zc[c];
     for (std::size_t k = 0; k + 1 < z.size(); ++k) {
       const double mid = 0.5 * (z[k] + z[k + 1]);
       bool in = false;
