@@ -134,7 +134,7 @@ bool plane_z(const PointGrid& g, int layer, double x, double y, double* z) {
 }
 
 // Heights of deposited material per cell, split into "earlier layers" and "this layer",
-// with maxima over 4 × 4 and 16 × 16 cells to skip cells that cannot collide.
+// with maxima over blocks of 64, 16 and 4 cells a side to skip cells that cannot collide.
 class Deposit {
  public:
   Deposit(const Vec2& lo, const Vec2& hi, double cell) : lo_(lo), cell_(cell) {
