@@ -1,6 +1,9 @@
 #include "layers/printability_cost.hpp"
 
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "nurbs/bspline_basis.hpp"
@@ -87,58 +90,75 @@ double printability_cost(const StackGrid& g, const Eigen::MatrixXd& Z, const Cos
   const int L = static_cast<int>(Z.rows());  // N + 1 surfaces
   const int n = static_cast<int>(g.xy.size());
   if (grad) grad->setZero(L - 2 > 0 ? L - 2 : 0, Z.cols());
-  double cost = 0;
-  std::vector<double> S(L), Sx(L), Sy(L), dS(L), dSx(L), dSy(L);
   // Heights of every layer at every sample, kept for the heater-block pairs below.
   const bool pairs = c.clearance < 1e299 && !g.block_pairs.empty() && L > 2;
   std::vector<double> all(pairs ? static_cast<std::size_t>(L) * n : 0);
-  for (int k = 0; k < n; ++k) {
-    const double* R = &g.R[static_cast<std::size_t>(k) * g.m];
-    const double* Rx = &g.Rx[static_cast<std::size_t>(k) * g.m];
-    const double* Ry = &g.Ry[static_cast<std::size_t>(k) * g.m];
-    for (int i = 0; i < L; ++i) {
-      double s = 0, sx = 0, sy = 0;
-      for (int a = 0; a < g.m; ++a) {
-        const double z = Z(i, g.control(k, a));
-        s += R[a] * z, sx += Rx[a] * z, sy += Ry[a] * z;
+  // The samples in a fixed number of chunks, in parallel; partial sums are added in chunk
+  // order, so the result does not depend on the threads.
+  constexpr int kChunks = 16;
+  std::array<double, kChunks> part{};
+  std::array<Eigen::MatrixXd, kChunks> part_grad;
+  tbb::parallel_for(0, kChunks, [&](int ch) {
+    double cost = 0;
+    Eigen::MatrixXd* gr = nullptr;
+    if (grad) part_grad[ch].setZero(grad->rows(), grad->cols()), gr = &part_grad[ch];
+    std::vector<double> S(L), Sx(L), Sy(L), dS(L), dSx(L), dSy(L);
+    const int k0 = static_cast<int>(static_cast<long>(n) * ch / kChunks);
+    const int k1 = static_cast<int>(static_cast<long>(n) * (ch + 1) / kChunks);
+    for (int k = k0; k < k1; ++k) {
+      const double* R = &g.R[static_cast<std::size_t>(k) * g.m];
+      const double* Rx = &g.Rx[static_cast<std::size_t>(k) * g.m];
+      const double* Ry = &g.Ry[static_cast<std::size_t>(k) * g.m];
+      for (int i = 0; i < L; ++i) {
+        double s = 0, sx = 0, sy = 0;
+        for (int a = 0; a < g.m; ++a) {
+          const double z = Z(i, g.control(k, a));
+          s += R[a] * z, sx += Rx[a] * z, sy += Ry[a] * z;
+        }
+        S[i] = s, Sx[i] = sx, Sy[i] = sy;
+        if (pairs) all[static_cast<std::size_t>(i) * n + k] = s;
+        dS[i] = dSx[i] = dSy[i] = 0;
       }
-      S[i] = s, Sx[i] = sx, Sy[i] = sy;
-      if (pairs) all[static_cast<std::size_t>(i) * n + k] = s;
-      dS[i] = dSx[i] = dSy[i] = 0;
-    }
-    const double ak = g.area[k];
-    const bool on = g.on_patch[k];
-    for (int i = 0; i + 1 < L; ++i) {
-      const double t = S[i] - S[i + 1];
-      double dt = 0;  // ∂C/∂t
-      if (on) {
-        cost += ak * (t - c.h) * (t - c.h);
-        dt += 2 * ak * (t - c.h);
-        const double ex = Sx[i] - Sx[i + 1], ey = Sy[i] - Sy[i + 1];
-        cost += ak * c.lambda * (ex * ex + ey * ey);
-        dSx[i] += 2 * ak * c.lambda * ex, dSx[i + 1] -= 2 * ak * c.lambda * ex;
-        dSy[i] += 2 * ak * c.lambda * ey, dSy[i + 1] -= 2 * ak * c.lambda * ey;
+      const double ak = g.area[k];
+      const bool on = g.on_patch[k];
+      for (int i = 0; i + 1 < L; ++i) {
+        const double t = S[i] - S[i + 1];
+        double dt = 0;  // ∂C/∂t
+        if (on) {
+          cost += ak * (t - c.h) * (t - c.h);
+          dt += 2 * ak * (t - c.h);
+          const double ex = Sx[i] - Sx[i + 1], ey = Sy[i] - Sy[i + 1];
+          cost += ak * c.lambda * (ex * ex + ey * ey);
+          dSx[i] += 2 * ak * c.lambda * ex, dSx[i + 1] -= 2 * ak * c.lambda * ex;
+          dSy[i] += 2 * ak * c.lambda * ey, dSy[i + 1] -= 2 * ak * c.lambda * ey;
+        }
+        if (t < c.h_min)
+          cost += ak * c.mu * (c.h_min - t) * (c.h_min - t), dt -= 2 * ak * c.mu * (c.h_min - t);
+        if (t > c.h_max)
+          cost += ak * c.mu * (t - c.h_max) * (t - c.h_max), dt += 2 * ak * c.mu * (t - c.h_max);
+        dS[i] += dt, dS[i + 1] -= dt;
       }
-      if (t < c.h_min)
-        cost += ak * c.mu * (c.h_min - t) * (c.h_min - t), dt -= 2 * ak * c.mu * (c.h_min - t);
-      if (t > c.h_max)
-        cost += ak * c.mu * (t - c.h_max) * (t - c.h_max), dt += 2 * ak * c.mu * (t - c.h_max);
-      dS[i] += dt, dS[i + 1] -= dt;
-    }
-    for (int i = 1; i + 1 < L; ++i) {  // the top is fixed (the part) and the bottom is flat
-      const double sl = std::hypot(Sx[i], Sy[i]);
-      if (sl > c.g) {
-        cost += ak * c.mu * (sl - c.g) * (sl - c.g);
-        const double f = 2 * ak * c.mu * (sl - c.g) / sl;
-        dSx[i] += f * Sx[i], dSy[i] += f * Sy[i];
+      for (int i = 1; i + 1 < L; ++i) {  // the top is fixed (the part) and the bottom is flat
+        const double sl = std::hypot(Sx[i], Sy[i]);
+        if (sl > c.g) {
+          cost += ak * c.mu * (sl - c.g) * (sl - c.g);
+          const double f = 2 * ak * c.mu * (sl - c.g) / sl;
+          dSx[i] += f * Sx[i], dSy[i] += f * Sy[i];
+        }
+      }
+      if (!gr) continue;
+      for (int i = 1; i + 1 < L; ++i) {
+        if (dS[i] == 0 && dSx[i] == 0 && dSy[i] == 0) continue;
+        for (int a = 0; a < g.m; ++a)
+          (*gr)(i - 1, g.control(k, a)) += dS[i] * R[a] + dSx[i] * Rx[a] + dSy[i] * Ry[a];
       }
     }
-    if (!grad) continue;
-    for (int i = 1; i + 1 < L; ++i) {
-      if (dS[i] == 0 && dSx[i] == 0 && dSy[i] == 0) continue;
-      for (int a = 0; a < g.m; ++a)
-        (*grad)(i - 1, g.control(k, a)) += dS[i] * R[a] + dSx[i] * Rx[a] + dSy[i] * Ry[a];
-    }
+    part[ch] = cost;
+  });
+  double cost = 0;
+  for (int ch = 0; ch < kChunks; ++ch) {
+    cost += part[ch];
+    if (grad) *grad += part_grad[ch];
   }
   // Heater block: a layer may not rise more than H within the block radius. Only the
   // intermediate layers are free; the top is the part and the bottom is flat.
