@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <optional>
 
+#include "layers/banded_field.hpp"
 #include "nonplanar/deform.hpp"
 #include "nonplanar/pipeline.hpp"
 
@@ -127,14 +128,16 @@ Expected<SliceResult> attempt(const TriangleMesh& mesh, const SliceJob& job, con
   // earlier layers from the independent check.
   const LayerParams& L = job.layers;
   // The band a location belongs to: the stack whose footprint (grown by a blend) holds it.
+  // The band a location belongs to: the one whose blend weight β is largest there (the
+  // stacks and the field's bands are in the same order).
+  const auto* banded = dynamic_cast<const layers::BandedField*>(r.plan.field.get());
   auto band_at = [&](const Vec3& p) {
-    if (r.plan.field->planar_at(p.x(), p.y())) return -1;
+    if (!banded) return -1;
     int best = -1;
-    double dist = 1e300;
-    for (const LayerStack& st : r.plan.stacks) {
-      const Vec2 c = 0.5 * (st.xy_min + st.xy_max);
-      const double d = (p.head<2>() - c).norm();
-      if (d < dist) dist = d, best = st.patch;
+    double top = 0;
+    for (std::size_t b = 0; b < banded->bands().size(); ++b) {
+      const double beta = banded->bands()[b].beta(p.x(), p.y());
+      if (beta > top) top = beta, best = r.plan.stacks[b].patch;
     }
     return best;
   };
