@@ -67,8 +67,9 @@ class PointGrid {
         for (std::size_t k = it->second.begin; k < it->second.end; ++k) f(pts_[k]);
       }
   }
-  /// The highest layer with a point within r (≤ kNear) of (x, y), or -1.
-  int top_layer(double x, double y, double r) const {
+  /// The highest layer with a point within r (≤ kNear) of (x, y) and no higher than z_max,
+  /// or -1.
+  int top_layer(double x, double y, double r, double z_max) const {
     const long i = cell(x), j = cell(y);
     int top = -1;
     for (long a = i - 1; a <= i + 1; ++a)
@@ -77,7 +78,8 @@ class PointGrid {
         if (it == by_cell_.end()) continue;
         // Sorted by layer within a cell: scan down from the top, stop at the best so far.
         for (std::size_t k = it->second.end; k-- > it->second.begin && pts_[k].layer > top;)
-          if ((pts_[k].p.head<2>() - Vec2(x, y)).squaredNorm() <= r * r) top = pts_[k].layer;
+          if (pts_[k].p.z() <= z_max && (pts_[k].p.head<2>() - Vec2(x, y)).squaredNorm() <= r * r)
+            top = pts_[k].layer;
       }
     return top;
   }
@@ -360,7 +362,9 @@ Expected<CheckFigures> check_print(const std::vector<PrintMove>& moves, const Tr
         const Vec3 s = a + (i + 1.0 / 3.0) / m * (b - a) + (j + 1.0 / 3.0) / m * (c - a);
         ++f.surface_samples;
         // The highest layer whose extrusion covers this XY within half a line width.
-        const int top = grid->top_layer(s.x(), s.y(), 0.225 + 0.1);
+        // The layer that prints this surface: the highest one near it, ignoring material
+        // more than 1 mm above it (another part of the model over this one, as an arch).
+        const int top = grid->top_layer(s.x(), s.y(), 0.225 + 0.1, s.z() + 1.0);
         double z = 0;
         if (top < 0 || !plane_z(*grid, top, s.x(), s.y(), &z)) continue;
         ++f.covered_samples;

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "nonplanar/check.hpp"
+#include "support/solids.hpp"
 
 namespace nonplanar {
 namespace {
@@ -70,6 +71,23 @@ TEST(CheckPrint, CollisionsOnlyModeCountsTheSame) {
   EXPECT_EQ(a->first_collision_line, b->first_collision_line);
   EXPECT_EQ(a->extrusions, b->extrusions);
   EXPECT_EQ(b->thickness_max, 0.0);  // not measured in the gate
+}
+
+// A top surface with other material high above it (an arch, a second body): the layer that
+// prints the surface is the one at its height, not the highest one over it.
+TEST(CheckPrint, DeviationIgnoresMaterialFarAbove) {
+  TriangleMesh mesh = test::box({0, 0, 0}, {10, 10, 0.2});
+  const TriangleMesh plate = test::box({0, 0, 4.8}, {10, 10, 5.0});
+  const int off = static_cast<int>(mesh.vertices.size());
+  mesh.vertices.insert(mesh.vertices.end(), plate.vertices.begin(), plate.vertices.end());
+  for (auto f : plate.faces) mesh.faces.push_back({f[0] + off, f[1] + off, f[2] + off});
+  std::vector<PrintMove> moves;
+  raster(moves, 0, 10, 10, 0.2);
+  raster(moves, 1, 10, 10, 5.0);  // (its support is not the point here)
+  auto f = check_print(moves, &mesh, {}, {});
+  ASSERT_TRUE(f);
+  EXPECT_GT(f->covered_samples, 0.9 * static_cast<double>(f->surface_samples));
+  EXPECT_LT(f->deviation_max, 1e-6);  // both tops printed exactly at their heights
 }
 
 }  // namespace
