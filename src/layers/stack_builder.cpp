@@ -298,11 +298,7 @@ StackResult build_stack(const TriangleMesh& mesh, const Patch& patch, int patch_
   b.T_bottom = st.T_bottom;
   // The top's range over the patch bounds it elsewhere (see Band::top_lo); a hair of slack
   // so points between grid samples on the patch are never touched.
-  b.top_lo = 1e300, b.top_hi = -1e300;
-  for (int kk = 0; kk < n; ++kk)
-    if (grid.on_patch[kk])
-      b.top_lo = std::min(b.top_lo, top_z[kk]), b.top_hi = std::max(b.top_hi, top_z[kk]);
-  b.top_lo -= 0.01, b.top_hi += 0.01;
+  b.top_lo = zmin - 0.01, b.top_hi = zmax + 0.01;
   // How far the curved layers sit from the planar ones decides how gently they blend.
   double dev = 0;
   for (int kk = 0; kk < n; ++kk)
