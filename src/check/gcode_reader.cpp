@@ -140,6 +140,10 @@ Expected<std::vector<PrintMove>> read_gcode_moves(std::string_view text) {
 std::vector<PrintMove> moves_from_toolpaths(const std::vector<LayerToolpaths>& layers,
                                             const GcodeParams& g) {
   std::vector<PrintMove> out;
+  std::size_t n = 0;
+  for (const LayerToolpaths& L : layers)
+    for (const ExtrusionPath& p : L.paths) n += p.points.size();
+  out.reserve(n);
   Vec3 pos(0, 0, 0);
   for (std::size_t li = 0; li < layers.size(); ++li)
     for (const ExtrusionPath& p : layers[li].paths) {
