@@ -50,6 +50,23 @@ TEST_P(StlLineEndings, AsciiParsesAndIgnoresStoredNormals) {
 
 INSTANTIATE_TEST_SUITE_P(Endings, StlLineEndings, ::testing::Values("\n", "\r\n", "\r"));
 
+// Over the triangle limit: a clear error naming the file and both counts, not an attempt
+// to build the mesh (the CLI's limit is 50 million).
+TEST(Stl, MoreTrianglesThanTheLimitIsAnError) {
+  const auto dir = test::temp_dir("stl_limit");
+  ASSERT_TRUE(write_stl(dir / "box.stl", test::box({0, 0, 0}, {10, 10, 10})));
+  LoadParams p;
+  p.max_triangles = 11;
+  const auto r = load_mesh(dir / "box.stl", p, {});
+  ASSERT_FALSE(r);
+  EXPECT_EQ(r.error().status, Status::invalid_mesh);
+  EXPECT_NE(r.error().message.find("box.stl: 12 triangles, over the limit of 11"),
+            std::string::npos)
+      << r.error().message;
+  p.max_triangles = 12;
+  EXPECT_TRUE(load_mesh(dir / "box.stl", p, {}));
+}
+
 TEST(Stl, BinaryWhoseHeaderStartsWithSolidIsBinary) {
   const auto dir = test::temp_dir("stl_solid_header");
   const TriangleMesh m = sample_solid();
