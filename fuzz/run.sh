@@ -2,7 +2,7 @@
 # Run the libFuzzer targets (one per parser; AddressSanitizer + UndefinedBehaviorSanitizer).
 # Usage: fuzz/run.sh [SECONDS=60] [TARGET...]
 #   TARGET: stl obj off 3mf ini json surfaces gcode (default: all of them, two at a time).
-# Builds build-san/ through scripts/sanitize.sh's configuration if the targets are missing.
+# Builds the missing targets in build-san/ with scripts/sanitize.sh --build-only.
 # Seeds come from ../shared/models and tests/data; corpora grow in build-san/corpus/TARGET,
 # so longer runs pick up where the last one stopped. Findings are written to
 # build-san/findings/ and the script fails when any target crashes, leaks or reports UB.
@@ -17,10 +17,7 @@ out=${BUILD_DIR:-build-san}
 missing=0
 for t in "${targets[@]}"; do [[ -x "$out/fuzz/fuzz_$t" ]] || missing=1; done
 if ((missing)); then
-  bash scripts/setup.sh --with-clang
-  CXX=clang++-14 cmake -S . -B "$out" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DNONPLANAR_FUZZ=ON \
-    -DNONPLANAR_BUILD_BENCH=OFF >/dev/null
-  cmake --build "$out" -j"$(nproc)" --target "${targets[@]/#/fuzz_}"
+  BUILD_DIR=$out bash scripts/sanitize.sh --build-only "${targets[@]/#/fuzz_}"
 fi
 
 models=../shared/models

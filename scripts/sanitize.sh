@@ -2,6 +2,7 @@
 # The whole test suite under AddressSanitizer + UndefinedBehaviorSanitizer, built with clang-14
 # into build-san/ (which also holds the libFuzzer targets that fuzz/run.sh runs).
 # Any sanitizer report fails the test that triggered it.
+# Usage: scripts/sanitize.sh [--build-only [TARGET...]]  (fuzz/run.sh builds its targets so)
 # Environment: BUILD_DIR (default build-san); CI=true turns warnings into errors.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -14,6 +15,11 @@ command -v ninja >/dev/null && [[ ! -f "$build_dir/CMakeCache.txt" ]] && generat
 # RelWithDebInfo: optimised enough that the pipeline tests finish, with line numbers in reports.
 CXX=clang++-14 cmake -S . -B "$build_dir" "${generator[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DNONPLANAR_FUZZ=ON -DNONPLANAR_BUILD_BENCH=OFF -DNONPLANAR_WERROR="$werror" >/dev/null
+if [[ "${1:-}" == "--build-only" ]]; then
+  shift
+  cmake --build "$build_dir" -j"$(nproc)" ${1:+--target "$@"}
+  exit 0
+fi
 cmake --build "$build_dir" -j"$(nproc)"
 export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=1:strict_string_checks=1}
 export LSAN_OPTIONS=${LSAN_OPTIONS:-suppressions=$PWD/scripts/lsan.supp:print_suppressions=0}

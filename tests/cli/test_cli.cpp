@@ -6,24 +6,16 @@
 #include <cstdio>
 #include <nlohmann/json.hpp>
 
+#include "support/cli.hpp"
 #include "support/files.hpp"
 #include "support/solids.hpp"
 
 namespace nonplanar {
 namespace {
 
-struct CliResult {
-  int code;
-  std::string out, err;
-};
-
+using test::CliResult;
 CliResult run(const std::string& args) {
-  const auto dir = test::temp_dir("cli_run");
-  const std::string cmd = std::string(NONPLANAR_CLI) + " " + args + " >" + (dir / "out").string() +
-                          " 2>" + (dir / "err").string();
-  const int status = std::system(cmd.c_str());
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status),
-          test::read_bytes(dir / "out"), test::read_bytes(dir / "err")};
+  return test::run_cli(args);
 }
 
 TEST(Cli, AnalyzeJsonReportsPatches) {

@@ -14,6 +14,7 @@
 #include <random>
 #include <thread>
 
+#include "support/cli.hpp"
 #include "support/files.hpp"
 #include "support/solids.hpp"
 
@@ -24,19 +25,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct CliRun {
-  int code;  ///< exit code, or 128 + signal
-  std::string err;
-};
-
-// Runs the CLI with a time limit; a run that needs longer is killed and reported as a hang.
-CliRun cli(const std::string& args, int limit_s = 300) {
-  const auto dir = test::temp_dir("hostile_run");
-  const std::string cmd = "timeout -s KILL " + std::to_string(limit_s) + " " + NONPLANAR_CLI + " " +
-                          args + " >/dev/null 2>" + (dir / "err").string();
-  const int status = std::system(cmd.c_str());
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status),
-          test::read_bytes(dir / "err")};
+using CliRun = test::CliResult;
+CliRun cli(const std::string& args) {
+  return test::run_cli(args);
 }
 
 std::size_t lines(const std::string& s) {
