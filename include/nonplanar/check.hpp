@@ -2,12 +2,14 @@
 // PrusaSlicer's / OrcaSlicer's) into moves and recomputes every quality figure from them.
 #pragma once
 
+#include <functional>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include "nonplanar/config.hpp"
 #include "nonplanar/context.hpp"
+#include "nonplanar/mesh.hpp"
 #include "nonplanar/toolpaths.hpp"
 
 namespace nonplanar {
@@ -28,9 +30,12 @@ struct PrintMove {
 /// G80) pass. Arcs (G2/G3), inches (G20) and unknown G-codes are errors naming the line.
 Expected<std::vector<PrintMove>> read_gcode_moves(std::string_view text);
 
-/// The same moves straight from toolpaths (for the check before a file is written).
-std::vector<PrintMove> moves_from_toolpaths(const std::vector<LayerToolpaths>& layers,
-                                            const GcodeParams& g);
+/// The same moves straight from toolpaths (for the check before a file is written); when
+/// `keep` is given, only the paths it accepts (the travel to the next kept path starts where
+/// the last kept one ended).
+std::vector<PrintMove> moves_from_toolpaths(
+    const std::vector<LayerToolpaths>& layers, const GcodeParams& g,
+    const std::function<bool(const ExtrusionPath&)>& keep = nullptr);
 
 /// Printer geometry and limits used by the figures. mm, degrees.
 struct CheckParams {
@@ -44,6 +49,10 @@ struct CheckParams {
   /// Only steepest extrusion and collisions (the slicer's safety gate, which measures
   /// thickness from its own paths): thickness, volume and deviation are left at 0.
   bool collisions_only = false;
+  /// When not empty, collisions are looked for only at extrusion points inside these boxes
+  /// (every extrusion still counts as material). For a caller that knows no point outside
+  /// them can collide, as the slicer's gate does: two planar layers never do.
+  std::vector<BoundingBox> collision_zones;
 };
 
 /// The figures of DESIGN.md §4. Deviation is vertical, mm; thickness is the height of each

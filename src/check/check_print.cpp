@@ -139,9 +139,12 @@ bool plane_z(const PointGrid& g, int layer, double x, double y, double* z) {
 // with maxima over blocks of 64, 16 and 4 cells a side to skip cells that cannot collide.
 class Deposit {
  public:
-  Deposit(const Vec2& lo, const Vec2& hi, double cell) : lo_(lo), cell_(cell) {
-    nx_ = static_cast<int>((hi.x() - lo.x()) / cell) + 2;
-    ny_ = static_cast<int>((hi.y() - lo.y()) / cell) + 2;
+  // The cells sit on a fixed lattice (multiples of 64 cells from the origin), so a check of
+  // a subset of the moves (the slicer's gate) sees the same cells as a check of them all.
+  Deposit(const Vec2& lo, const Vec2& hi, double cell)
+      : lo_((lo / (kSize[0] * cell)).array().floor() * (kSize[0] * cell)), cell_(cell) {
+    nx_ = static_cast<int>((hi.x() - lo_.x()) / cell) + 2;
+    ny_ = static_cast<int>((hi.y() - lo_.y()) / cell) + 2;
     cells_.assign(static_cast<std::size_t>(nx_) * ny_, Cell{});
     for (int l = 0; l < kLevels; ++l) {
       lx_[l] = nx_ / kSize[l] + 1, ly_[l] = ny_ / kSize[l] + 1;
@@ -309,6 +312,12 @@ Expected<CheckFigures> check_print(const std::vector<PrintMove>& moves, const Tr
   ctx.progress("check", 0.3);
 
   // Collisions, in print order.
+  auto in_zone = [&](const Vec3& p) {
+    if (cp.collision_zones.empty()) return true;
+    for (const BoundingBox& z : cp.collision_zones)
+      if ((p.array() >= z.min.array()).all() && (p.array() <= z.max.array()).all()) return true;
+    return false;
+  };
   Deposit dep(lo - Vec2(cp.block_radius + 1, cp.block_radius + 1),
               hi + Vec2(cp.block_radius + 1, cp.block_radius + 1), 0.2);
   for (std::size_t mi = 0; mi < moves.size(); ++mi) {
@@ -319,7 +328,7 @@ Expected<CheckFigures> check_print(const std::vector<PrintMove>& moves, const Tr
     const int n = std::max(1, static_cast<int>(std::ceil(len / 0.2)));
     for (int k = 1; k <= n; ++k) {
       const Vec3 p = m.from + (m.to - m.from) * (static_cast<double>(k) / n);
-      if (dep.collides(p, m.layer, cp, tan_a, 0.5 * cp.layer_height)) {
+      if (in_zone(p) && dep.collides(p, m.layer, cp, tan_a, 0.5 * cp.layer_height)) {
         if (f.collisions == 0) f.first_collision = p, f.first_collision_line = m.line;
         // Spread out (1 mm apart at least): one long collision must not fill the list.
         if (f.collision_points.size() < 4096 &&

@@ -96,7 +96,11 @@ double Band::beta(double x, double y) const {
 
 double Band::delta(double x, double y, double z, const PlanarLayers& pl) const {
   if (z <= c) return 0.0;
-  const Basis b = basis(x, y);
+  return delta(basis(x, y), z, pl);
+}
+
+double Band::delta(const Basis& b, double z, const PlanarLayers& pl) const {
+  if (z <= c) return 0.0;
   const double S0 = surface(b, 0);
   if (z <= S0) {
     // S decreases with i: binary search for S_i ≥ z ≥ S_{i+1}.
@@ -129,6 +133,48 @@ void set_blend(Band& b, const PatchRaster& r, double blend) {
     b.blend[k] = 1.0 - smoothstep((r.dist[k] - inner) / blend);
 }
 
+class BandedField::Column {
+ public:
+  Column(const BandedField& f, double x, double y) : pl_(f.pl_) {
+    double sum = 0;
+    const std::size_t nb = std::min<std::size_t>(f.bands_.size(), 64);
+    for (std::size_t b = 0; b < nb; ++b) {
+      const double beta = f.bands_[b].beta(x, y);
+      sum += beta;
+      if (beta <= 0) continue;
+      if (n_ == kMax) {  // more overlapping bands than kept: T evaluates them directly
+        field_ = &f, x_ = x, y_ = y;
+        break;
+      }
+      band_[n_] = &f.bands_[b], beta_[n_] = beta, basis_[n_] = f.bands_[b].basis(x, y), ++n_;
+    }
+    scale_ = sum > 1.0 ? 1.0 / sum : 1.0;
+  }
+  double T(double z) const {
+    if (field_) return field_->T(x_, y_, z);
+    double t = pl_.T(z);
+    for (int k = 0; k < n_; ++k) t += scale_ * beta_[k] * band_[k]->delta(basis_[k], z, pl_);
+    return t;
+  }
+  bool planar() const { return n_ == 0 && !field_; }
+  /// The one band with β = 1 here when no other band reaches, else null.
+  const Band* only(const Band::Basis** basis) const {
+    if (field_ || n_ != 1 || beta_[0] < 1 - 1e-12) return nullptr;
+    *basis = &basis_[0];
+    return band_[0];
+  }
+
+ private:
+  static constexpr int kMax = 8;
+  const PlanarLayers& pl_;
+  const BandedField* field_ = nullptr;  ///< set when more than kMax bands overlap here
+  double x_ = 0, y_ = 0, scale_ = 1;
+  int n_ = 0;
+  const Band* band_[kMax];
+  double beta_[kMax];
+  Band::Basis basis_[kMax];
+};
+
 double BandedField::T(double x, double y, double z) const {
   double beta[64], sum = 0;
   const std::size_t nb = std::min<std::size_t>(bands_.size(), 64);
@@ -144,40 +190,31 @@ double BandedField::z_at(double x, double y, double t) const {
   // Closed forms first: where no band reaches, T is planar; where exactly one band has β = 1
   // (on its patch), T inside the stack is T_bottom + N − s with s the fractional surface
   // index, so z interpolates the two surfaces around s. Everywhere else, root-find.
-  const Band* only = nullptr;
-  bool mixed = false;
-  for (const Band& b : bands_) {
-    const double beta = b.beta(x, y);
-    if (beta <= 0) continue;
-    if (beta >= 1 - 1e-12 && !only)
-      only = &b;
-    else
-      mixed = true;
-  }
-  if (!only && !mixed) return pl_.zeta(t);
-  if (only && !mixed) {
+  const Column col(*this, x, y);
+  if (col.planar()) return pl_.zeta(t);
+  const Band::Basis* basis = nullptr;
+  if (const Band* only = col.only(&basis)) {
     if (t <= only->T_bottom) return pl_.zeta(t);
     const double s = only->T_bottom + only->N - t;  // 0 at the top surface, N at the plane
     if (s >= 0) {
-      const Band::Basis b = only->basis(x, y);
       const int i = std::min(static_cast<int>(std::floor(s)), only->N - 1);
       const double f = s - i;
-      const double Si = only->surface(b, i);
-      return Si + f * (only->surface(b, i + 1) - Si);
+      const double Si = only->surface(*basis, i);
+      return Si + f * (only->surface(*basis, i + 1) - Si);
     }
   }
   // T increases in z: bracket around the planar guess, then bisection with a secant step
   // (Illinois) to 1e-10 mm.
   const double z0 = pl_.zeta(t);
   double lo = z0 - 1.0, hi = z0 + 1.0;
-  double flo = T(x, y, lo) - t, fhi = T(x, y, hi) - t;
-  for (int k = 0; flo > 0 && k < 60; ++k) lo -= (hi - lo), flo = T(x, y, lo) - t;
-  for (int k = 0; fhi < 0 && k < 60; ++k) hi += (hi - lo), fhi = T(x, y, hi) - t;
+  double flo = col.T(lo) - t, fhi = col.T(hi) - t;
+  for (int k = 0; flo > 0 && k < 60; ++k) lo -= (hi - lo), flo = col.T(lo) - t;
+  for (int k = 0; fhi < 0 && k < 60; ++k) hi += (hi - lo), fhi = col.T(hi) - t;
   int side = 0;
   for (int it = 0; it < 200 && hi - lo > 1e-10; ++it) {
     double z = (lo * fhi - hi * flo) / (fhi - flo);
     if (!(z > lo && z < hi)) z = 0.5 * (lo + hi);
-    const double f = T(x, y, z) - t;
+    const double f = col.T(z) - t;
     if (f == 0) return z;
     if ((f < 0) == (flo < 0)) {
       lo = z, flo = f;
@@ -194,7 +231,8 @@ double BandedField::z_at(double x, double y, double t) const {
 
 double BandedField::thickness(double x, double y, double z) const {
   const double e = 1e-5;
-  const double d = (T(x, y, z + e) - T(x, y, z - e)) / (2 * e);
+  const Column col(*this, x, y);
+  const double d = (col.T(z + e) - col.T(z - e)) / (2 * e);
   return d > 0 ? 1.0 / d : 1e300;
 }
 

@@ -48,6 +48,8 @@ struct Band {
   void heights(double x, double y, double* S) const;
   double beta(double x, double y) const;
   double delta(double x, double y, double z, const PlanarLayers& pl) const;
+  /// δ at height z of the column whose basis is `b` (basis(x, y) computed once per column).
+  double delta(const Basis& b, double z, const PlanarLayers& pl) const;
 };
 
 /// β control values from a patch raster: 1 within 3 nodes of the patch (so the B-spline is
@@ -70,6 +72,10 @@ class BandedField final : public LayerField {
   const std::vector<Band>& bands() const { return bands_; }
 
  private:
+  /// T along one vertical line: the bands' β and bases depend on (x, y) only, so a root-find
+  /// or a difference quotient evaluates them once (the sum keeps T's order of terms, so the
+  /// value is bit-identical to T(x, y, z)).
+  class Column;
   PlanarLayers pl_;
   std::vector<Band> bands_;
 };

@@ -1,0 +1,38 @@
+#include "deform/gate_zones.hpp"
+
+#include <algorithm>
+
+namespace nonplanar {
+
+bool GateZones::may_matter(const ExtrusionPath& p) const {
+  BoundingBox pb;
+  for (const Vec3& v : p.points) pb.extend(v);
+  for (const BoundingBox& z : material)
+    if ((pb.max.array() >= z.min.array()).all() && (pb.min.array() <= z.max.array()).all())
+      return true;
+  return false;
+}
+
+GateZones gate_zones(const layers::BandedField& field, double R) {
+  GateZones g;
+  for (const layers::Band& b : field.bands()) {
+    const double cell = b.blend_cell;
+    // β vanishes two cells past its raster (the support of its cubic B-spline); one more
+    // cell of margin.
+    const Vec2 lo = b.blend_origin - Vec2(3 * cell, 3 * cell);
+    const Vec2 hi = b.blend_origin + Vec2((b.blend_nx + 2) * cell, (b.blend_ny + 2) * cell);
+    // The top's highest point over the support, sampled at the raster's nodes (between
+    // them a smooth surface rises by far less than the 1 mm of slack).
+    double top = b.c;
+    for (int i = 0; i <= b.blend_nx + 5; ++i)
+      for (int j = 0; j <= b.blend_ny + 5; ++j)
+        top = std::max(top, b.surface(b.basis(lo.x() + i * cell, lo.y() + j * cell), 0));
+    const double z0 = b.c - 1.0, z1 = top + b.fade + 1.0;
+    g.query.push_back({{lo.x() - R - 1, lo.y() - R - 1, z0}, {hi.x() + R + 1, hi.y() + R + 1, z1}});
+    g.material.push_back({{lo.x() - 2 * R - 1, lo.y() - 2 * R - 1, z0},
+                          {hi.x() + 2 * R + 1, hi.y() + 2 * R + 1, 1e300}});
+  }
+  return g;
+}
+
+}  // namespace nonplanar

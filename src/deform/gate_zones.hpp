@@ -1,0 +1,32 @@
+// Where the slicer's safety gate must look for collisions (DESIGN.md §3).
+//
+// Notation: per band, its support is where β > 0, c its plane, S_0 its (tamed) top and L_rec
+// its fade; R is the heater block's radius.
+#pragma once
+
+#include <vector>
+
+#include "layers/banded_field.hpp"
+#include "nonplanar/mesh.hpp"
+#include "nonplanar/toolpaths.hpp"
+
+namespace nonplanar {
+
+/// The layers are planar outside every band's support, and inside it below c and above
+/// S_0 + L_rec. Two planar layers cannot collide (earlier material lies a layer below the
+/// nozzle), so a collision needs a curved layer within R of the nozzle:
+/// - `query`: per band, its support grown by R, from c up to above its top: no extrusion
+///   point outside every such box can collide (CheckParams::collision_zones);
+/// - `material`: per band, its support grown by 2R, from c up: the only earlier material a
+///   query point can meet. Every box has 1 mm of slack on each side.
+struct GateZones {
+  std::vector<BoundingBox> query, material;
+  /// Does the path's bounding box meet a `material` box? (A path that does not cannot
+  /// matter to the gate.)
+  bool may_matter(const ExtrusionPath& p) const;
+};
+
+/// The zones of every band of `field`; R in mm.
+GateZones gate_zones(const layers::BandedField& field, double R);
+
+}  // namespace nonplanar
