@@ -31,11 +31,11 @@ struct PrintMove {
 Expected<std::vector<PrintMove>> read_gcode_moves(std::string_view text);
 
 /// The same moves straight from toolpaths (for the check before a file is written); when
-/// `keep` is given, only the paths it accepts (the travel to the next kept path starts where
-/// the last kept one ended).
+/// `keep` is given, only the paths it accepts, called with each path and its layer (the
+/// travel to the next kept path starts where the last kept one ended).
 std::vector<PrintMove> moves_from_toolpaths(
     const std::vector<LayerToolpaths>& layers, const GcodeParams& g,
-    const std::function<bool(const ExtrusionPath&)>& keep = nullptr);
+    const std::function<bool(const ExtrusionPath&, int layer)>& keep = nullptr);
 
 /// Printer geometry and limits used by the figures. mm, degrees.
 struct CheckParams {

@@ -109,6 +109,11 @@ class LayerField {
   virtual double T(double x, double y, double z) const = 0;
   /// z with T(x, y, z) = t (the inverse along the vertical; |error| < 1e-9 mm).
   virtual double z_at(double x, double y, double t) const = 0;
+  /// z_at for n layer coordinates t[0..n) on one vertical line, into z[0..n): a field may
+  /// share the work that depends on (x, y) only.
+  virtual void z_at(double x, double y, const double* t, double* z, int n) const {
+    for (int i = 0; i < n; ++i) z[i] = z_at(x, y, t[i]);
+  }
   /// Planar height of layer coordinate t: ζ(t).
   virtual double zeta(double t) const = 0;
   /// Inverse of zeta.

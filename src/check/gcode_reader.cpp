@@ -137,18 +137,18 @@ Expected<std::vector<PrintMove>> read_gcode_moves(std::string_view text) {
   return moves;
 }
 
-std::vector<PrintMove> moves_from_toolpaths(const std::vector<LayerToolpaths>& layers,
-                                            const GcodeParams& g,
-                                            const std::function<bool(const ExtrusionPath&)>& keep) {
+std::vector<PrintMove> moves_from_toolpaths(
+    const std::vector<LayerToolpaths>& layers, const GcodeParams& g,
+    const std::function<bool(const ExtrusionPath&, int)>& keep) {
   std::vector<PrintMove> out;
   std::size_t n = 0;
   for (const LayerToolpaths& L : layers)
-    for (const ExtrusionPath& p : L.paths) n += !keep || keep(p) ? p.points.size() : 0;
+    for (const ExtrusionPath& p : L.paths) n += p.points.size();
   out.reserve(n);
   Vec3 pos(0, 0, 0);
   for (std::size_t li = 0; li < layers.size(); ++li)
     for (const ExtrusionPath& p : layers[li].paths) {
-      if (p.points.empty() || (keep && !keep(p))) continue;
+      if (p.points.empty() || (keep && !keep(p, static_cast<int>(li)))) continue;
       PrintMove t;
       t.from = pos, t.to = p.points[0], t.layer = static_cast<int>(li), t.type = role_name(p.role);
       t.width = p.width;

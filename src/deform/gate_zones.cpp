@@ -4,12 +4,44 @@
 
 namespace nonplanar {
 
-bool GateZones::may_matter(const ExtrusionPath& p) const {
-  BoundingBox pb;
-  for (const Vec3& v : p.points) pb.extend(v);
-  for (const BoundingBox& z : material)
-    if ((pb.max.array() >= z.min.array()).all() && (pb.min.array() <= z.max.array()).all())
-      return true;
+namespace {
+
+BoundingBox box_of(const ExtrusionPath& p) {
+  BoundingBox b;
+  for (const Vec3& v : p.points) b.extend(v);
+  return b;
+}
+
+bool meet(const BoundingBox& a, const BoundingBox& b) {
+  return (a.max.array() >= b.min.array()).all() && (a.min.array() <= b.max.array()).all();
+}
+
+bool inside(const Vec3& p, const BoundingBox& b) {
+  return (p.array() >= b.min.array()).all() && (p.array() <= b.max.array()).all();
+}
+
+}  // namespace
+
+void GateZones::find_last_layers(const std::vector<LayerToolpaths>& layers) {
+  last_layer.assign(query.size(), -1);
+  for (std::size_t li = 0; li < layers.size(); ++li)
+    for (const ExtrusionPath& p : layers[li].paths) {
+      const BoundingBox pb = box_of(p);
+      for (std::size_t b = 0; b < query.size(); ++b) {
+        if (last_layer[b] >= static_cast<int>(li) || !meet(pb, query[b])) continue;
+        for (const Vec3& v : p.points)
+          if (inside(v, query[b])) {
+            last_layer[b] = static_cast<int>(li);
+            break;
+          }
+      }
+    }
+}
+
+bool GateZones::may_matter(const ExtrusionPath& p, int layer) const {
+  const BoundingBox pb = box_of(p);
+  for (std::size_t b = 0; b < material.size(); ++b)
+    if ((b >= last_layer.size() || layer <= last_layer[b]) && meet(pb, material[b])) return true;
   return false;
 }
 

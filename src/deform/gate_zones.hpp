@@ -17,13 +17,17 @@ namespace nonplanar {
 /// nozzle), so a collision needs a curved layer within R of the nozzle:
 /// - `query`: per band, its support grown by R, from c up to above its top: no extrusion
 ///   point outside every such box can collide (CheckParams::collision_zones);
-/// - `material`: per band, its support grown by 2R, from c up: the only earlier material a
-///   query point can meet. Every box has 1 mm of slack on each side.
+/// - `material`: per band, its support grown by 2R, from c up, and no later than the last
+///   layer with a point in its query box: the only material a query point can meet (it
+///   must be of an earlier layer). Every box has 1 mm of slack on each side.
 struct GateZones {
   std::vector<BoundingBox> query, material;
-  /// Does the path's bounding box meet a `material` box? (A path that does not cannot
-  /// matter to the gate.)
-  bool may_matter(const ExtrusionPath& p) const;
+  std::vector<int> last_layer;  ///< per band: the last layer with a point in its query box
+  /// Sets last_layer from the paths (layers[i] is layer i).
+  void find_last_layers(const std::vector<LayerToolpaths>& layers);
+  /// Can this path of layer `layer` matter to the gate (meet a material box, no later than
+  /// its last layer)?
+  bool may_matter(const ExtrusionPath& p, int layer) const;
 };
 
 /// The zones of every band of `field`; R in mm.

@@ -20,9 +20,10 @@ struct Mapped {
 
 Mapped map_point(const LayerField& f, const Vec3& q, double h_planar) {
   if (f.planar_at(q.x(), q.y())) return {q, h_planar};
-  const double t = f.t_of_zeta(q.z()), t0 = f.t_of_zeta(q.z() - h_planar);
-  const double z = f.z_at(q.x(), q.y(), t), z0 = f.z_at(q.x(), q.y(), t0);
-  return {{q.x(), q.y(), z}, z - z0};
+  const double t[2] = {f.t_of_zeta(q.z()), f.t_of_zeta(q.z() - h_planar)};
+  double z[2];
+  f.z_at(q.x(), q.y(), t, z, 2);
+  return {{q.x(), q.y(), z[0]}, z[0] - z[1]};
 }
 
 // Appends the mapped segment a → b (a already emitted), splitting at midpoints while the

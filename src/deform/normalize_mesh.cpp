@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdint>
 #include <unordered_map>
+#include <unordered_set>
 
 #include "nonplanar/deform.hpp"
 
@@ -33,17 +34,25 @@ Expected<NormalizedMesh> normalize_mesh(const TriangleMesh& mesh, const LayerFie
   tbb::parallel_for(std::size_t{0}, m.vertices.size(),
                     [&](std::size_t v) { image[v] = mapped(field, m.vertices[v]); });
 
+  // Edges already tested and kept whole keep their ends (vertices are only appended), so
+  // the same test would keep them whole again: only edges made by a split are tested, and a
+  // face no edge of which was split is final. (Re-testing every edge of the part every
+  // round was most of this stage's time.)
+  std::unordered_set<std::uint64_t> settled;
+  std::vector<char> final_face(m.faces.size(), 0);
   for (int round = 0; round < params.max_rounds; ++round) {
     if (ctx.cancelled()) return Error{Status::cancelled, "cancelled"};
     // Decide per edge once; the midpoint index is shared by both faces (conforming).
     std::unordered_map<std::uint64_t, int> mid;
-    mid.reserve(m.faces.size());
     std::vector<std::pair<int, int>> edges;  // each edge once, in face order
-    for (const auto& f : m.faces)
+    for (std::size_t fi = 0; fi < m.faces.size(); ++fi) {
+      if (final_face[fi]) continue;
       for (int k = 0; k < 3; ++k) {
-        const int a = f[k], b = f[(k + 1) % 3];
-        if (mid.emplace(edge_key(a, b), -1).second) edges.emplace_back(a, b);
+        const int a = m.faces[fi][k], b = m.faces[fi][(k + 1) % 3];
+        if (!settled.count(edge_key(a, b)) && mid.emplace(edge_key(a, b), -1).second)
+          edges.emplace_back(a, b);
       }
+    }
     std::vector<Vec3> im(edges.size());
     std::vector<char> split_it(edges.size());
     tbb::parallel_for(std::size_t{0}, edges.size(), [&](std::size_t e) {
@@ -56,7 +65,10 @@ Expected<NormalizedMesh> normalize_mesh(const TriangleMesh& mesh, const LayerFie
       split_it[e] = long_curved || (im[e] - 0.5 * (image[a] + image[b])).norm() > params.tolerance;
     });
     for (std::size_t e = 0; e < edges.size(); ++e) {
-      if (!split_it[e]) continue;
+      if (!split_it[e]) {
+        settled.insert(edge_key(edges[e].first, edges[e].second));
+        continue;
+      }
       const auto [a, b] = edges[e];
       mid[edge_key(a, b)] = static_cast<int>(m.vertices.size());
       m.vertices.push_back(0.5 * (m.vertices[a] + m.vertices[b]));
@@ -64,11 +76,18 @@ Expected<NormalizedMesh> normalize_mesh(const TriangleMesh& mesh, const LayerFie
     }
     std::size_t split = 0;
     std::vector<std::array<int, 3>> faces;
+    std::vector<char> final_next;
     faces.reserve(m.faces.size());
-    for (const auto& f : m.faces) {
-      int e[3];
+    final_next.reserve(m.faces.size());
+    for (std::size_t fi = 0; fi < m.faces.size(); ++fi) {
+      const auto& f = m.faces[fi];
+      int e[3] = {-1, -1, -1};
       int n = 0;
-      for (int k = 0; k < 3; ++k) n += (e[k] = mid[edge_key(f[k], f[(k + 1) % 3])]) >= 0;
+      if (!final_face[fi])
+        for (int k = 0; k < 3; ++k) {
+          const auto it = mid.find(edge_key(f[k], f[(k + 1) % 3]));
+          n += (e[k] = it == mid.end() ? -1 : it->second) >= 0;
+        }
       if (n == 0) {
         faces.push_back(f);
       } else if (n == 1) {
@@ -90,9 +109,11 @@ Expected<NormalizedMesh> normalize_mesh(const TriangleMesh& mesh, const LayerFie
         faces.push_back({mca, mbc, c});
         faces.push_back({mab, mbc, mca});
       }
+      final_next.resize(faces.size(), n == 0);
     }
     for (const auto& [key, v] : mid) split += v >= 0;
     m.faces = std::move(faces);
+    final_face = std::move(final_next);
     out.rounds = round + 1;
     out.edges_split += split;
     ctx.progress("normalize", std::min(1.0, 0.1 * (round + 1)));

@@ -196,12 +196,14 @@ Expected<SliceResult> attempt(const TriangleMesh& mesh, const SliceJob& job, con
   cp.collisions_only = true;
   // Only where a curved layer is within the heater block's reach (gate_zones.hpp): on the
   // bunny that skipped most of 24 million extrusion samples.
-  const GateZones zones = banded ? gate_zones(*banded, cp.block_radius) : GateZones{};
+  GateZones zones = banded ? gate_zones(*banded, cp.block_radius) : GateZones{};
+  zones.find_last_layers(r.layers);
   cp.collision_zones = zones.query;
-  auto figures = check_print(
-      moves_from_toolpaths(r.layers, job.print.gcode,
-                           [&](const ExtrusionPath& p) { return !banded || zones.may_matter(p); }),
-      nullptr, cp, ctx);
+  auto figures = check_print(moves_from_toolpaths(r.layers, job.print.gcode,
+                                                  [&](const ExtrusionPath& p, int li) {
+                                                    return !banded || zones.may_matter(p, li);
+                                                  }),
+                             nullptr, cp, ctx);
   if (!figures) return figures.error();
   r.collisions = figures->collisions;
   if (figures->collisions > 0)

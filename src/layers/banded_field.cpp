@@ -187,10 +187,18 @@ double BandedField::T(double x, double y, double z) const {
 }
 
 double BandedField::z_at(double x, double y, double t) const {
+  return z_at(Column(*this, x, y), t);
+}
+
+void BandedField::z_at(double x, double y, const double* t, double* z, int n) const {
+  const Column col(*this, x, y);
+  for (int i = 0; i < n; ++i) z[i] = z_at(col, t[i]);
+}
+
+double BandedField::z_at(const Column& col, double t) const {
   // Closed forms first: where no band reaches, T is planar; where exactly one band has β = 1
   // (on its patch), T inside the stack is T_bottom + N − s with s the fractional surface
   // index, so z interpolates the two surfaces around s. Everywhere else, root-find.
-  const Column col(*this, x, y);
   if (col.planar()) return pl_.zeta(t);
   const Band::Basis* basis = nullptr;
   if (const Band* only = col.only(&basis)) {

@@ -61,6 +61,7 @@ class BandedField final : public LayerField {
   BandedField(PlanarLayers pl, std::vector<Band> bands) : pl_(pl), bands_(std::move(bands)) {}
   double T(double x, double y, double z) const override;
   double z_at(double x, double y, double t) const override;
+  void z_at(double x, double y, const double* t, double* z, int n) const override;
   double zeta(double t) const override { return pl_.zeta(t); }
   double t_of_zeta(double z) const override { return pl_.t_of_zeta(z); }
   double thickness(double x, double y, double z) const override;
@@ -76,6 +77,7 @@ class BandedField final : public LayerField {
   /// or a difference quotient evaluates them once (the sum keeps T's order of terms, so the
   /// value is bit-identical to T(x, y, z)).
   class Column;
+  double z_at(const Column& col, double t) const;
   PlanarLayers pl_;
   std::vector<Band> bands_;
 };

@@ -37,10 +37,11 @@ TEST(GateZones, FindEveryCollisionTheFullCheckFinds) {
   auto full = check_print(all, nullptr, cp, {});
   ASSERT_TRUE(full);
 
-  const GateZones zones = gate_zones(*field, cp.block_radius);
+  GateZones zones = gate_zones(*field, cp.block_radius);
+  zones.find_last_layers(r->layers);
   ASSERT_EQ(zones.query.size(), 1u);
   const std::vector<PrintMove> near = moves_from_toolpaths(
-      r->layers, c.gcode, [&](const ExtrusionPath& p) { return zones.may_matter(p); });
+      r->layers, c.gcode, [&](const ExtrusionPath& p, int li) { return zones.may_matter(p, li); });
   cp.collision_zones = zones.query;
   auto gated = check_print(near, nullptr, cp, {});
   ASSERT_TRUE(gated);
