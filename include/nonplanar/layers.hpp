@@ -122,6 +122,18 @@ class LayerField {
   virtual double thickness(double x, double y, double z) const = 0;
   /// True where no band reaches (x, y): there T is planar at every z.
   virtual bool planar_at(double x, double y) const = 0;
+  /// True when T is planar on the segment a → b (XY) for every layer coordinate in
+  /// [t_lo, t_hi]; may answer false for a segment that only passes near a curved band. The
+  /// default samples planar_at every 0.1 mm (and ignores t).
+  virtual bool planar_along(const Vec2& a, const Vec2& b, double t_lo, double t_hi) const {
+    (void)t_lo, (void)t_hi;
+    const int n = 1 + static_cast<int>((b - a).norm() / 0.1);
+    for (int i = 0; i <= n; ++i) {
+      const Vec2 p = a + (b - a) * (static_cast<double>(i) / n);
+      if (!planar_at(p.x(), p.y())) return false;
+    }
+    return true;
+  }
 };
 
 /// A vertical cross-section of the part as SVG: the part's outline, every layer boundary

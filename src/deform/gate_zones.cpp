@@ -47,22 +47,13 @@ bool GateZones::may_matter(const ExtrusionPath& p, int layer) const {
 
 GateZones gate_zones(const layers::BandedField& field, double R) {
   GateZones g;
-  for (const layers::Band& b : field.bands()) {
-    const double cell = b.blend_cell;
-    // β vanishes two cells past its raster (the support of its cubic B-spline); one more
-    // cell of margin.
-    const Vec2 lo = b.blend_origin - Vec2(3 * cell, 3 * cell);
-    const Vec2 hi = b.blend_origin + Vec2((b.blend_nx + 2) * cell, (b.blend_ny + 2) * cell);
-    // The top's highest point over the support, sampled at the raster's nodes (between
-    // them a smooth surface rises by far less than the 1 mm of slack).
-    double top = b.c;
-    for (int i = 0; i <= b.blend_nx + 5; ++i)
-      for (int j = 0; j <= b.blend_ny + 5; ++j)
-        top = std::max(top, b.surface(b.basis(lo.x() + i * cell, lo.y() + j * cell), 0));
-    const double z0 = b.c - 1.0, z1 = top + b.fade + 1.0;
-    g.query.push_back({{lo.x() - R - 1, lo.y() - R - 1, z0}, {hi.x() + R + 1, hi.y() + R + 1, z1}});
-    g.material.push_back({{lo.x() - 2 * R - 1, lo.y() - 2 * R - 1, z0},
-                          {hi.x() + 2 * R + 1, hi.y() + 2 * R + 1, 1e300}});
+  for (std::size_t n = 0; n < field.bands().size(); ++n) {
+    const layers::BandedField::Reach& r = field.reach()[n];
+    const double z0 = field.bands()[n].c - 1.0;
+    g.query.push_back(
+        {{r.lo.x() - R - 1, r.lo.y() - R - 1, z0}, {r.hi.x() + R + 1, r.hi.y() + R + 1, r.z_top}});
+    g.material.push_back({{r.lo.x() - 2 * R - 1, r.lo.y() - 2 * R - 1, z0},
+                          {r.hi.x() + 2 * R + 1, r.hi.y() + 2 * R + 1, 1e300}});
   }
   return g;
 }

@@ -13,8 +13,8 @@
 namespace nonplanar {
 
 /// The layers are planar outside every band's support, and inside it below c and above
-/// S_0 + L_rec. Two planar layers cannot collide (earlier material lies a layer below the
-/// nozzle), so a collision needs a curved layer within R of the nozzle:
+/// S_0 + L_rec (BandedField::reach). Two planar layers cannot collide (earlier material lies a
+/// layer below the nozzle), so a collision needs a curved layer within R of the nozzle:
 /// - `query`: per band, its support grown by R, from c up to above its top: no extrusion
 ///   point outside every such box can collide (CheckParams::collision_zones);
 /// - `material`: per band, its support grown by 2R, from c up, and no later than the last

@@ -133,6 +133,49 @@ void set_blend(Band& b, const PatchRaster& r, double blend) {
     b.blend[k] = 1.0 - smoothstep((r.dist[k] - inner) / blend);
 }
 
+BandedField::BandedField(PlanarLayers pl, std::vector<Band> bands)
+    : pl_(pl), bands_(std::move(bands)) {
+  for (const Band& b : bands_) {
+    Reach r;
+    // β vanishes two cells past its raster (the support of the cubic B-spline).
+    const double cell = b.blend_cell;
+    r.lo = b.blend_origin - Vec2(2 * cell, 2 * cell);
+    r.hi = b.blend_origin + Vec2((b.blend_nx + 1) * cell, (b.blend_ny + 1) * cell);
+    // The top's highest point, sampled at the raster's nodes; between them a smooth surface
+    // rises by far less than the millimetre of slack.
+    double top = b.c;
+    for (int i = 0; i <= b.blend_nx + 3; ++i)
+      for (int j = 0; j <= b.blend_ny + 3; ++j)
+        top = std::max(top, b.surface(b.basis(r.lo.x() + i * cell, r.lo.y() + j * cell), 0));
+    r.z_top = top + b.fade + 1.0;
+    r.t_top = pl_.T(r.z_top);
+    reach_.push_back(r);
+  }
+}
+
+bool BandedField::planar_along(const Vec2& a, const Vec2& b, double t_lo, double t_hi) const {
+  for (std::size_t n = 0; n < reach_.size(); ++n) {
+    const Reach& r = reach_[n];
+    if (t_hi <= bands_[n].T_bottom || t_lo >= r.t_top) continue;  // layers it leaves planar
+    // Slab test of the segment against the box (Liang–Barsky).
+    double t0 = 0, t1 = 1;
+    bool miss = false;
+    for (int k = 0; k < 2 && !miss; ++k) {
+      const double d = b[k] - a[k];
+      if (std::abs(d) < 1e-15) {
+        miss = a[k] < r.lo[k] || a[k] > r.hi[k];
+        continue;
+      }
+      double u = (r.lo[k] - a[k]) / d, v = (r.hi[k] - a[k]) / d;
+      if (u > v) std::swap(u, v);
+      t0 = std::max(t0, u), t1 = std::min(t1, v);
+      miss = t0 > t1;
+    }
+    if (!miss) return false;
+  }
+  return true;
+}
+
 class BandedField::Column {
  public:
   Column(const BandedField& f, double x, double y) : pl_(f.pl_) {

@@ -58,7 +58,7 @@ void set_blend(Band& b, const PatchRaster& r, double blend);
 
 class BandedField final : public LayerField {
  public:
-  BandedField(PlanarLayers pl, std::vector<Band> bands) : pl_(pl), bands_(std::move(bands)) {}
+  BandedField(PlanarLayers pl, std::vector<Band> bands);
   double T(double x, double y, double z) const override;
   double z_at(double x, double y, double t) const override;
   void z_at(double x, double y, const double* t, double* z, int n) const override;
@@ -70,7 +70,17 @@ class BandedField final : public LayerField {
       if (b.beta(x, y) > 0) return false;
     return true;
   }
+  /// False when the segment crosses a band's support box within the layers it bends.
+  bool planar_along(const Vec2& a, const Vec2& b, double t_lo, double t_hi) const override;
   const std::vector<Band>& bands() const { return bands_; }
+  /// Where a band can bend the layers: β > 0 only inside [lo, hi] (XY), and the layers only
+  /// between c and z_top (its top's highest point over that box, plus its fade), i.e. for
+  /// layer coordinates in (T_bottom, t_top).
+  struct Reach {
+    Vec2 lo, hi;
+    double z_top = 0, t_top = 0;
+  };
+  const std::vector<Reach>& reach() const { return reach_; }
 
  private:
   /// T along one vertical line: the bands' β and bases depend on (x, y) only, so a root-find
@@ -80,6 +90,7 @@ class BandedField final : public LayerField {
   double z_at(const Column& col, double t) const;
   PlanarLayers pl_;
   std::vector<Band> bands_;
+  std::vector<Reach> reach_;  ///< per band
 };
 
 }  // namespace nonplanar::layers

@@ -1,0 +1,114 @@
+// Where a curved band bends the layers (BandedField::reach), and the two stages that rely on
+// it. The safety gate looks for collisions only near bands (deform/gate_zones.hpp): that must
+// lose nothing, so with a printer so tight that the curved layers collide a lot, the gate's
+// count equals the full check's while it reads far fewer moves. Mapping back splits a line
+// wherever it crosses a band, even when its ends and middle are planar.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "deform/gate_zones.hpp"
+#include "nonplanar/deform.hpp"
+#include "nonplanar/pipeline.hpp"
+#include "support/solids.hpp"
+
+namespace nonplanar {
+namespace {
+
+// A 10 mm slab with a dome on its flat top: planar material beside the curved band at the
+// band's own height. Sliced with the default printer: one curved band.
+struct DomeOnSlab {
+  PrintConfig c;
+  SliceResult r;
+  const layers::BandedField* field = nullptr;
+  DomeOnSlab() {
+    auto top = [](double x, double y) {
+      const double r2 = (x - 30) * (x - 30) + (y - 30) * (y - 30);
+      return r2 < 144 ? 10 + 0.01 * (144 - r2) : 10.0;
+    };
+    TriangleMesh mesh = test::height_field_solid(top, 0, 60, 0, 60, 120, 120);
+    for (Vec3& v : mesh.vertices) v += Vec3(80, 80, 0);
+    auto s = slice_model(mesh, make_job(c), {});
+    EXPECT_TRUE(s) << s.error().message;
+    if (!s) return;
+    r = std::move(*s);
+    field = dynamic_cast<const layers::BandedField*>(r.plan.field.get());
+  }
+};
+
+TEST(GateZones, FindEveryCollisionTheFullCheckFinds) {
+  const DomeOnSlab d;
+  const PrintConfig& c = d.c;
+  const SliceResult* r = &d.r;
+  ASSERT_EQ(r->plan.stacks.size(), 1u);
+  const layers::BandedField* field = d.field;
+  ASSERT_NE(field, nullptr);
+
+  // A heater block 0.3 mm above the tip and a 10° cone: the dome's layers now collide.
+  CheckParams cp;
+  cp.block_clearance = 0.3;
+  cp.nozzle_angle_deg = 10;
+  cp.collisions_only = true;
+  const std::vector<PrintMove> all = moves_from_toolpaths(r->layers, c.gcode);
+  auto full = check_print(all, nullptr, cp, {});
+  ASSERT_TRUE(full);
+
+  GateZones zones = gate_zones(*field, cp.block_radius);
+  zones.find_last_layers(r->layers);
+  ASSERT_EQ(zones.query.size(), 1u);
+  const std::vector<PrintMove> near = moves_from_toolpaths(
+      r->layers, c.gcode, [&](const ExtrusionPath& p, int li) { return zones.may_matter(p, li); });
+  cp.collision_zones = zones.query;
+  auto gated = check_print(near, nullptr, cp, {});
+  ASSERT_TRUE(gated);
+
+  EXPECT_GT(full->collisions, 100u);
+  EXPECT_EQ(gated->collisions, full->collisions);
+  EXPECT_EQ(gated->first_collision, full->first_collision);
+  EXPECT_EQ(gated->collision_points.size(), full->collision_points.size());
+  // The slab below the band is left out.
+  EXPECT_LT(static_cast<double>(near.size()), 0.9 * static_cast<double>(all.size()));
+}
+
+// A straight extrusion whose ends and middle lie where the layers are planar, but which
+// crosses the band on its way, is mapped onto the curved layer all along (a 110 mm infill
+// line on the bunny was left at its planar height over a blend zone, 0.01 mm above the
+// layer under it).
+TEST(MapToolpaths, ALongLineCrossingABandFollowsTheCurvedLayer) {
+  const DomeOnSlab d;
+  ASSERT_NE(d.field, nullptr);
+  ASSERT_EQ(d.field->reach().size(), 1u);
+  const layers::BandedField::Reach& box = d.field->reach()[0];
+  const layers::Band& band = d.field->bands()[0];
+  // Halfway up the band, from 5 mm left of its box to far enough right that the middle is
+  // beyond the box too.
+  const double t = band.T_bottom + 0.5 * band.N, zeta = d.field->zeta(t);
+  const double y = 0.5 * (box.lo.y() + box.hi.y());
+  const double x0 = box.lo.x() - 5, x1 = box.hi.x() + (box.hi.x() - box.lo.x()) + 10;
+  ASSERT_FALSE(!d.field->planar_at(x0, y) || !d.field->planar_at(x1, y) ||
+               !d.field->planar_at(0.5 * (x0 + x1), y));
+  LayerToolpaths L;
+  L.z = zeta;
+  ExtrusionPath p;
+  p.role = ExtrusionRole::internal_infill;
+  p.points = {{x0, y, zeta}, {x1, y, zeta}};
+  p.height = {0.2, 0.2};
+  L.paths.push_back(p);
+  auto mapped = map_toolpaths_back({L}, *d.field, {}, {});
+  ASSERT_TRUE(mapped);
+  const std::vector<Vec3>& q = (*mapped)[0].paths.at(0).points;
+  // Everywhere along the mapped polyline, within the tolerance of the curved layer; and
+  // the layer does leave the plane here.
+  double worst = 0, bent = 0;
+  for (std::size_t k = 1; k < q.size(); ++k)
+    for (int s = 0; s <= 20; ++s) {
+      const Vec3 v = q[k - 1] + (q[k] - q[k - 1]) * (s / 20.0);
+      const double z = d.field->z_at(v.x(), v.y(), t);
+      worst = std::max(worst, std::abs(v.z() - z));
+      bent = std::max(bent, std::abs(z - zeta));
+    }
+  EXPECT_GT(bent, 0.1);
+  EXPECT_LE(worst, MapBackParams{}.tolerance + 1e-6);
+}
+}  // namespace
+}  // namespace nonplanar
