@@ -108,29 +108,34 @@ class PointGrid {
 // z of the least-squares plane through points of `layer` within kNear of (x, y). Points
 // along one line do not define a plane (a fit would extrapolate across it): then the
 // nearest point's height is used.
-bool plane_z(const PointGrid& g, int layer, double x, double y, double* z) {
+// With `line`, the nearest point is returned there (when within 0.2 mm) and its height is
+// not used: the caller handles a layer that is only a line here.
+bool plane_z(const PointGrid& g, int layer, double x, double y, double* z, Vec3* line = nullptr) {
   Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
   Eigen::Vector3d b = Eigen::Vector3d::Zero();
   int n = 0;
   double nearest = 1e300, z_near = 0;
+  Vec3 p_near(0, 0, 0);
   g.near(x, y, layer, [&](const Pt& q) {
     const double dx = q.p.x() - x, dy = q.p.y() - y, d2 = dx * dx + dy * dy;
     if (d2 > kNear * kNear) return;
     const Eigen::Vector3d r(1, dx, dy);
     A += r * r.transpose();
     b += r * q.p.z();
-    if (d2 < nearest) nearest = d2, z_near = q.p.z();
+    if (d2 < nearest) nearest = d2, z_near = q.p.z(), p_near = q.p;
     ++n;
   });
   if (n == 0) return false;
   *z = z_near;
-  if (n < 3) return nearest <= 0.2 * 0.2;
+  if (line) *line = p_near;
+  const bool close = nearest <= 0.2 * 0.2;
+  if (n < 3) return !line && close;
   // Spread of the points in XY: the smallest eigenvalue of their covariance.
   const double mx = A(0, 1) / n, my = A(0, 2) / n;
   Eigen::Matrix2d cov;
   cov << A(1, 1) / n - mx * mx, A(1, 2) / n - mx * my, A(1, 2) / n - mx * my, A(2, 2) / n - my * my;
   if (Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(cov).eigenvalues()[0] < 0.05 * 0.05)
-    return nearest <= 0.2 * 0.2;  // a slope makes a farther point's height misleading
+    return !line && close;  // a slope makes a farther point's height misleading
   *z = A.ldlt().solve(b)[0];
   return true;
 }
@@ -301,8 +306,22 @@ Expected<CheckFigures> check_print(const std::vector<PrintMove>& moves, const Tr
     for (std::size_t k = 0; k < all.size(); k += 3) {
       const Pt& q = all[k];
       double below = 0;
-      if (q.layer > 0 && !plane_z(*grid, q.layer - 1, q.p.x(), q.p.y(), &below)) continue;
-      const double t = q.p.z() - below;  // (no plane below: a bridge, not a thickness)
+      double t = q.p.z();
+      Vec3 r(1e300, 0, 0);
+      if (q.layer > 0 && plane_z(*grid, q.layer - 1, q.p.x(), q.p.y(), &below, &r)) {
+        t = q.p.z() - below;
+      } else if (q.layer > 0) {
+        // The layer below is a single line here (the edge of a region): on a slope its
+        // nearest point's height is off by the slope times the distance, so measure at that
+        // point instead, under this layer's own plane there (consecutive layers are nearly
+        // parallel). No point within 0.2 mm: a bridge, not a thickness.
+        double above = 0;
+        Vec3 unused;
+        if (r.x() > 1e299 || (r.head<2>() - q.p.head<2>()).squaredNorm() > 0.2 * 0.2 ||
+            !plane_z(*grid, q.layer, r.x(), r.y(), &above, &unused))
+          continue;
+        t = above - r.z();
+      }
       f.thickness_min = std::min(f.thickness_min, t);
       f.thickness_max = std::max(f.thickness_max, t);
     }

@@ -30,6 +30,24 @@ TEST(CheckPrint, StackedLayersHaveTheirThicknessAndNoCollision) {
   EXPECT_NEAR(f->steepest_deg, 0, 1e-9);
 }
 
+TEST(CheckPrint, ThicknessOverTheEdgeOfASlopedLayerBelow) {
+  // Layer 0 is one line along x at y = 0, z = 0.2; layer 1 is a raster sloped in y,
+  // z = 0.4 + 0.5 y: 0.2 mm above layer 0 where it lies. (Measured from the line's nearest
+  // point, a line of layer 1 at y = 0.15 was 0.275 mm thick.)
+  std::vector<PrintMove> moves;
+  raster(moves, 0, 10, 0, 0.2);
+  for (double y = -0.3; y <= 0.3 + 1e-9; y += 0.15) {
+    PrintMove m;
+    m.from = {0, y, 0.4 + 0.5 * y}, m.to = {10, y, 0.4 + 0.5 * y};
+    m.filament = 0.3, m.extruding = true, m.layer = 1, m.type = "Solid infill";
+    moves.push_back(m);
+  }
+  auto f = check_print(moves, nullptr, {}, {});
+  ASSERT_TRUE(f);
+  EXPECT_NEAR(f->thickness_min, 0.2, 1e-6);
+  EXPECT_NEAR(f->thickness_max, 0.2, 1e-6);
+}
+
 TEST(CheckPrint, NozzleBelowEarlierMaterialCollides) {
   // Layer 0 is a raised ridge at z = 2 over x in [0, 10] (as a curved layer could leave);
   // layer 1 then prints flat at z = 0.4 right beside it: the nozzle cone meets the ridge.

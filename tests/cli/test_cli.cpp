@@ -95,10 +95,7 @@ TEST(Cli, FitReportsErrorsAndExportsSurfaces) {
 
 TEST(Cli, LayersReportsStacksAndWritesTheirFiles) {
   const auto dir = test::temp_dir("cli_layers");
-  ASSERT_TRUE(write_stl(
-      dir / "roof.stl",
-      test::height_field_solid([](double x, double) { return 8 + std::sin(2 * M_PI * x / 25); }, 0,
-                               50, 0, 30, 150, 60)));
+  ASSERT_TRUE(write_stl(dir / "roof.stl", test::sine_roof()));
   const CliResult r =
       run("layers --json " + (dir / "roof.stl").string() + " --export-layers " +
           (dir / "l.json").string() + " --export-normalized " + (dir / "n.stl").string() +
@@ -166,10 +163,7 @@ TEST(Cli, SlicePlanarWritesGcodeAndRefusesBadSettings) {
 
 TEST(Cli, SliceNonPlanarThenCheck) {
   const auto dir = test::temp_dir("cli_nonplanar");
-  ASSERT_TRUE(write_stl(
-      dir / "roof.stl",
-      test::height_field_solid([](double x, double) { return 8 + std::sin(2 * M_PI * x / 25); }, 0,
-                               50, 0, 30, 150, 60)));
+  ASSERT_TRUE(write_stl(dir / "roof.stl", test::sine_roof()));
   const std::string model = (dir / "roof.stl").string(), out = (dir / "roof.gcode").string();
   const CliResult s = run("slice " + model + " -o " + out);
   ASSERT_EQ(s.code, 0) << s.err;

@@ -157,10 +157,7 @@ TEST(HostileInput, LimitsAreErrorsNamingTheKeyOrSizes) {
   EXPECT_EQ(ini.code, 2);
   EXPECT_NE(ini.err.find("min_layer_height"), std::string::npos) << ini.err;
   // h_min and h_max from the profile reach the curved layers.
-  ASSERT_TRUE(write_stl(
-      dir / "roof.stl",
-      test::height_field_solid([](double x, double) { return 8 + std::sin(2 * M_PI * x / 25); }, 0,
-                               50, 0, 30, 100, 40)));
+  ASSERT_TRUE(write_stl(dir / "roof.stl", test::sine_roof(100, 40)));
   const CliRun ok = cli("slice -q " + (dir / "roof.stl").string() + " -o " + out +
                         " --min-layer-height 0.12 --max-layer-height 0.28");
   ASSERT_EQ(ok.code, 0) << ok.err;

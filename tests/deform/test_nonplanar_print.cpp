@@ -61,19 +61,13 @@ void expect_good(const Outcome& o, std::size_t stacks) {
 }
 
 TEST(NonplanarPrint, Saddle) {
-  expect_good(
-      run(test::height_field_solid([](double x, double y) { return 10 + (x * x - y * y) / 60.0; },
-                                   -12, 12, -12, 12, 72, 72)),
-      1);
+  expect_good(run(test::saddle()), 1);
 }
 
 TEST(NonplanarPrint, SineRoofAtFullInfillKeepsItsVolume) {
   PrintConfig c;
   c.paths.fill_density = 1.0;
-  const Outcome o =
-      run(test::height_field_solid([](double x, double) { return 8 + std::sin(2 * M_PI * x / 25); },
-                                   0, 50, 0, 30, 150, 60),
-          c);
+  const Outcome o = run(test::sine_roof(), c);
   expect_good(o, 1);
   EXPECT_NEAR(o.figures.volume_ratio, 1.0, 0.03);
 }
@@ -125,25 +119,11 @@ TEST(NonplanarPrint, TravelsClearPrintedMaterial) {
 }
 
 TEST(NonplanarPrint, TwoCurvedTowers) {
-  // One closed solid: a 3 mm plate with two 20 × 20 mm towers whose tops are domes (as a
-  // height field, the towers' walls are one 0.5 mm grid step wide, far steeper than 30°).
-  auto top = [](double x, double y) {
-    for (double cx : {20.0, 60.0})
-      if (std::abs(x - cx) <= 10 && std::abs(y - 20) <= 10)
-        return 18 + 2.0 * std::cos(0.1 * (x - cx)) * std::cos(0.1 * (y - 20));
-    return 3.0;
-  };
-  expect_good(run(test::height_field_solid(top, 0, 80, 0, 40, 160, 80)), 2);
+  expect_good(run(test::domed_towers()), 2);
 }
 
 TEST(NonplanarPrint, DomeCutByABox) {
-  const double R = 40, a = 12;
-  expect_good(run(test::height_field_solid(
-                  [&](double x, double y) {
-                    return 6 + std::sqrt(R * R - x * x - y * y) - std::sqrt(R * R - 2 * a * a);
-                  },
-                  -a, a, -a, a, 72, 72)),
-              1);
+  expect_good(run(test::dome_cut_by_box()), 1);
 }
 
 // A shared curved model whose fit swings off the patch (before the top was tamed there, the

@@ -42,11 +42,6 @@ TriangleMesh saddle() {
   return test::height_field_solid([](double x, double y) { return 10 + (x * x - y * y) / 60.0; },
                                   -12, 12, -12, 12, 96, 96);
 }
-TriangleMesh sine_roof() {
-  return test::height_field_solid(
-      [](double x, double) { return 8 + 1.0 * std::sin(2 * M_PI * x / 25); }, 0, 50, 0, 30, 150,
-      60);
-}
 TriangleMesh towers() {
   TriangleMesh m = test::box({0, 0, 0}, {80, 40, 3});
   auto dome = [](double cx, double cy) {
@@ -119,7 +114,7 @@ TEST(Layers, SaddleStackMeetsTheLimits) {
 }
 
 TEST(Layers, SineRoofStackMeetsTheLimits) {
-  const Planned p = plan_for(sine_roof());
+  const Planned p = plan_for(test::sine_roof());
   expect_printable(p, 1);
   expect_monotone_and_invertible(p);
 }
@@ -162,7 +157,7 @@ TEST(Layers, StackCacheGivesTheSamePlanWithFewerPatches) {
 }
 
 TEST(Layers, OptimiserLowersTheCostOfAPoorStart) {
-  const TriangleMesh m = sine_roof();
+  const TriangleMesh m = test::sine_roof();
   const Analysis a = *analyze(m, {}, {});
   const auto fit = fit_patch(m, a.patches[0], {}, {});
   ASSERT_TRUE(fit);

@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <cmath>
 #include <map>
 #include <utility>
 
@@ -107,6 +108,35 @@ std::filesystem::path temp_dir(const std::string& name) {
   std::filesystem::remove_all(p);
   std::filesystem::create_directories(p);
   return p;
+}
+
+TriangleMesh saddle() {
+  return height_field_solid([](double x, double y) { return 10 + (x * x - y * y) / 60.0; }, -12, 12,
+                            -12, 12, 72, 72);
+}
+
+TriangleMesh sine_roof(int nx, int ny) {
+  return height_field_solid([](double x, double) { return 8 + std::sin(2 * M_PI * x / 25); }, 0, 50,
+                            0, 30, nx, ny);
+}
+
+TriangleMesh domed_towers() {
+  auto top = [](double x, double y) {
+    for (double cx : {20.0, 60.0})
+      if (std::abs(x - cx) <= 10 && std::abs(y - 20) <= 10)
+        return 18 + 2.0 * std::cos(0.1 * (x - cx)) * std::cos(0.1 * (y - 20));
+    return 3.0;
+  };
+  return height_field_solid(top, 0, 80, 0, 40, 160, 80);
+}
+
+TriangleMesh dome_cut_by_box() {
+  const double R = 40, a = 12;
+  return height_field_solid(
+      [&](double x, double y) {
+        return 6 + std::sqrt(R * R - x * x - y * y) - std::sqrt(R * R - 2 * a * a);
+      },
+      -a, a, -a, a, 72, 72);
 }
 
 }  // namespace nonplanar::test

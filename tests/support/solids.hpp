@@ -27,6 +27,19 @@ TriangleMesh subdivide(const TriangleMesh& m, int levels);
 /// Appends b's vertices and faces to a.
 void append(TriangleMesh& a, const TriangleMesh& b);
 
+/// The analytic solids of the end-to-end issue (0.2 mm layers, max_angle 30°), with curved
+/// tops the non-planar pipeline must follow within 0.02 mm (p95):
+/// saddle: 24 × 24 mm, top 10 + (x² − y²) / 60 about its centre;
+TriangleMesh saddle();
+/// sine roof: 50 × 30 mm, top 8 + sin(2πx / 25); `nx` × `ny` grid quads;
+TriangleMesh sine_roof(int nx = 150, int ny = 60);
+/// two domed towers: a 3 mm plate 80 × 40 mm with two 20 × 20 mm towers whose tops are
+/// 18 + 2 cos(0.1 dx) cos(0.1 dy) (one closed height field; its walls one 0.5 mm step wide);
+TriangleMesh domed_towers();
+/// dome cut by a box: the top of a sphere of radius 40 over a 24 × 24 mm square, 6 mm high
+/// at the corners.
+TriangleMesh dome_cut_by_box();
+
 /// The shared test models folder (../shared/models beside the repo); empty if absent.
 std::filesystem::path shared_models();
 

@@ -1,0 +1,45 @@
+#!/usr/bin/env bash
+# The quality figures of DESIGN.md §4 for nonplanar's non-planar slice and PrusaSlicer's
+# planar one, side by side, measured by `nonplanar check` on both G-code files.
+# Usage: bench/compare_prusa_quality.sh [MODEL...]
+# Default models: the end-to-end issue's analytic solids (written by build/bench/
+# make_test_solids), the shared curved models (wing, FoilCutter, sphere) and
+# examples/wave_roof.stl. Same print both ways: 0.2 mm layers, 0.4 mm nozzle, max_angle 30°.
+# Installs prusa-slicer through scripts/setup.sh if needed, and builds.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+SETUP_ARGS=--with-prusaslicer bash scripts/build.sh >/dev/null
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+models=("$@")
+if ((${#models[@]} == 0)); then
+  ./build/bench/make_test_solids "$tmp/solids"
+  models=("$tmp"/solids/saddle.stl "$tmp"/solids/sine_roof.stl "$tmp"/solids/domed_towers.stl
+          "$tmp"/solids/dome_cut_by_box.stl ../shared/models/np_curvislicer_wing.stl
+          ../shared/models/np_curvislicer_FoilCutter.stl ../shared/models/np_prusa_sphere.stl
+          examples/wave_roof.stl)
+fi
+common=(--layer-height 0.2 --first-layer-height 0.2 --perimeters 2 --top-solid-layers 5
+        --bottom-solid-layers 4 --fill-density 20% --fill-pattern rectilinear --skirts 1
+        --nozzle-diameter 0.4 --filament-diameter 1.75 --temperature 210 --bed-temperature 60)
+# One row per slicer: deviation p95 / mean / max (mm), thickness min-max (mm), steepest (deg),
+# collisions; nonplanar's row also says how many curved stacks it printed.
+figures() {
+  ./build/nonplanar check -q --json "$1" --mesh "$2" | python3 -c '
+import json, sys
+j = json.load(sys.stdin)
+d = j["top_surface_deviation"]
+print("%7.4f %7.4f %7.4f  %5.3f-%5.3f %6.1f %6d" % (d["p95"], d["mean"], d["max"],
+      j["thickness_min"], j["thickness_max"], j["steepest_extrusion"], j["collisions"]))'
+}
+printf "%-34s %-11s %7s %7s %7s  %-11s %6s %6s  %s\n" model slicer p95 mean max thickness steep coll \
+  "curved stacks"
+for m in "${models[@]}"; do
+  name=$(basename "$m")
+  ./build/nonplanar slice -q "$m" -o "$tmp/np.gcode" "${common[@]}"
+  stacks=$(grep -c '^; patch .* curved layers' "$tmp/np.gcode" || true)
+  prusa-slicer --export-gcode "${common[@]}" --gcode-flavor marlin2 \
+    --bed-shape 0x0,220x0,220x220,0x220 --center 110,110 -o "$tmp/ps.gcode" "$m" >/dev/null 2>&1
+  printf "%-34s %-11s %s  %s\n" "$name" nonplanar "$(figures "$tmp/np.gcode" "$m")" "$stacks"
+  printf "%-34s %-11s %s\n" "" PrusaSlicer "$(figures "$tmp/ps.gcode" "$m")"
+done

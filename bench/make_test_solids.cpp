@@ -1,0 +1,32 @@
+// make_test_solids DIR: write the end-to-end issue's analytic solids (tests/support/solids.hpp)
+// as binary STL, for scripts that slice them with nonplanar and PrusaSlicer.
+#include <cstdio>
+#include <filesystem>
+#include <utility>
+
+#include "nonplanar/io.hpp"
+#include "support/solids.hpp"
+
+int main(int argc, char** argv) {
+  if (argc != 2) {
+    std::fprintf(stderr, "usage: make_test_solids DIR\n");
+    return 2;
+  }
+  const std::filesystem::path dir = argv[1];
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  namespace t = nonplanar::test;
+  const std::pair<const char*, nonplanar::TriangleMesh> solids[] = {
+      {"saddle.stl", t::saddle()},
+      {"sine_roof.stl", t::sine_roof()},
+      {"domed_towers.stl", t::domed_towers()},
+      {"dome_cut_by_box.stl", t::dome_cut_by_box()}};
+  for (const auto& [name, mesh] : solids) {
+    auto w = nonplanar::write_stl(dir / name, mesh);
+    if (!w) {
+      std::fprintf(stderr, "error: %s: %s\n", (dir / name).c_str(), w.error().message.c_str());
+      return 1;
+    }
+  }
+  return 0;
+}
