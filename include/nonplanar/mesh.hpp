@@ -30,6 +30,13 @@ struct BoundingBox {
     min = min.cwiseMin(p);
     max = max.cwiseMax(p);
   }
+  /// Closed box: points on its faces are inside.
+  bool contains(const Vec3& p) const {
+    return (p.array() >= min.array()).all() && (p.array() <= max.array()).all();
+  }
+  bool intersects(const BoundingBox& b) const {
+    return (max.array() >= b.min.array()).all() && (min.array() <= b.max.array()).all();
+  }
 };
 
 /// Bounding box of all vertices (including unreferenced ones).

@@ -334,7 +334,7 @@ Expected<CheckFigures> check_print(const std::vector<PrintMove>& moves, const Tr
   auto in_zone = [&](const Vec3& p) {
     if (cp.collision_zones.empty()) return true;
     for (const BoundingBox& z : cp.collision_zones)
-      if ((p.array() >= z.min.array()).all() && (p.array() <= z.max.array()).all()) return true;
+      if (z.contains(p)) return true;
     return false;
   };
   Deposit dep(lo - Vec2(cp.block_radius + 1, cp.block_radius + 1),

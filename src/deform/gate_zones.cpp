@@ -12,14 +12,6 @@ BoundingBox box_of(const ExtrusionPath& p) {
   return b;
 }
 
-bool meet(const BoundingBox& a, const BoundingBox& b) {
-  return (a.max.array() >= b.min.array()).all() && (a.min.array() <= b.max.array()).all();
-}
-
-bool inside(const Vec3& p, const BoundingBox& b) {
-  return (p.array() >= b.min.array()).all() && (p.array() <= b.max.array()).all();
-}
-
 }  // namespace
 
 void GateZones::find_last_layers(const std::vector<LayerToolpaths>& layers) {
@@ -28,9 +20,9 @@ void GateZones::find_last_layers(const std::vector<LayerToolpaths>& layers) {
     for (const ExtrusionPath& p : layers[li].paths) {
       const BoundingBox pb = box_of(p);
       for (std::size_t b = 0; b < query.size(); ++b) {
-        if (last_layer[b] >= static_cast<int>(li) || !meet(pb, query[b])) continue;
+        if (last_layer[b] >= static_cast<int>(li) || !pb.intersects(query[b])) continue;
         for (const Vec3& v : p.points)
-          if (inside(v, query[b])) {
+          if (query[b].contains(v)) {
             last_layer[b] = static_cast<int>(li);
             break;
           }
@@ -41,7 +33,8 @@ void GateZones::find_last_layers(const std::vector<LayerToolpaths>& layers) {
 bool GateZones::may_matter(const ExtrusionPath& p, int layer) const {
   const BoundingBox pb = box_of(p);
   for (std::size_t b = 0; b < material.size(); ++b)
-    if ((b >= last_layer.size() || layer <= last_layer[b]) && meet(pb, material[b])) return true;
+    if ((b >= last_layer.size() || layer <= last_layer[b]) && pb.intersects(material[b]))
+      return true;
   return false;
 }
 
