@@ -1,5 +1,7 @@
 #include "nonplanar/surface_io.hpp"
 
+#include <cstdint>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <ostream>
 
@@ -37,14 +39,27 @@ ordered_json to_json(const SurfaceRecord& r) {
   return j;
 }
 
+// An integer field. nlohmann's get<int>() casts a float such as 2e101 to int, which is undefined
+// behaviour (found by fuzz_surfaces under UBSan): only JSON integers that fit are accepted.
+int int_at(const nlohmann::json& j, const char* key) {
+  const auto& v = j.at(key);
+  if (!v.is_number_integer()) throw std::runtime_error(std::string(key) + " must be an integer");
+  constexpr auto lo = std::numeric_limits<int>::min(), hi = std::numeric_limits<int>::max();
+  const bool fits = v.is_number_unsigned()
+                        ? v.get<std::uint64_t>() <= std::uint64_t(hi)
+                        : v.get<std::int64_t>() >= lo && v.get<std::int64_t>() <= hi;
+  if (!fits) throw std::runtime_error(std::string(key) + " is out of range");
+  return int(v.get<std::int64_t>());
+}
+
 SurfaceRecord from_json(const nlohmann::json& j) {
   SurfaceRecord r;
   NurbsSurface& s = r.surface.surface;
-  r.patch = j.at("patch").get<int>();
-  s.p = j.at("degree_u").get<int>();
-  s.q = j.at("degree_v").get<int>();
-  s.n_u = j.at("count_u").get<int>();
-  s.n_v = j.at("count_v").get<int>();
+  r.patch = int_at(j, "patch");
+  s.p = int_at(j, "degree_u");
+  s.q = int_at(j, "degree_v");
+  s.n_u = int_at(j, "count_u");
+  s.n_v = int_at(j, "count_v");
   s.U = j.at("knots_u").get<std::vector<double>>();
   s.V = j.at("knots_v").get<std::vector<double>>();
   for (const auto& p : j.at("control_points")) {
@@ -57,7 +72,7 @@ SurfaceRecord from_json(const nlohmann::json& j) {
   r.surface.extent = {m.at("extent").at(0).get<double>(), m.at("extent").at(1).get<double>()};
   r.rms_error = j.value("rms_error", 0.0);
   r.max_error = j.value("max_error", 0.0);
-  r.layer = j.value("layer", -1);
+  r.layer = j.contains("layer") ? int_at(j, "layer") : -1;
   if (j.contains("footprint")) {
     const auto& f = j.at("footprint");
     r.has_footprint = true;

@@ -57,6 +57,20 @@ TEST(SurfaceIo, RejectsMalformedDocuments) {
   ASSERT_FALSE(ver);
   EXPECT_EQ(ver.error().status, Status::unsupported);
   EXPECT_FALSE(parse_surfaces_json(R"([{"format":"nonplanar-surfaces"}])"));
+  // A float or a huge number where an integer belongs is an error naming the key, not a cast
+  // (UBSan caught fuzz_surfaces casting 2.2e101 to int).
+  const std::pair<const char*, const char*> cases[] = {
+      {R"("patch":2.22222e101)", "patch"},
+      {R"("patch":1.5)", "patch"},
+      {R"("patch":4294967296)", "patch"},
+      {R"("patch":0,"degree_u":-9223372036854775808)", "degree_u"}};
+  for (const auto& [field, key] : cases) {
+    const auto r = parse_surfaces_json(
+        std::string(R"({"format":"nonplanar-surfaces","version":1,"surfaces":[{)") + field + "}]}");
+    ASSERT_FALSE(r) << field;
+    EXPECT_EQ(r.error().status, Status::parse_error);
+    EXPECT_NE(r.error().message.find(key), std::string::npos) << r.error().message;
+  }
 }
 
 TEST(SurfaceIo, ObjTessellationHasOneGridPerSurface) {
