@@ -56,6 +56,10 @@ int run(CheckOptions o) {
           {"covered_samples", f->covered_samples}}},
         {"thickness_min", f->thickness_min},
         {"thickness_max", f->thickness_max},
+        {"thickness_min_at",
+         {f->thickness_min_at.x(), f->thickness_min_at.y(), f->thickness_min_at.z()}},
+        {"thickness_max_at",
+         {f->thickness_max_at.x(), f->thickness_max_at.y(), f->thickness_max_at.z()}},
         {"steepest_extrusion", f->steepest_deg},
         {"collisions", f->collisions},
         {"first_collision", f->collisions == 0
@@ -75,7 +79,12 @@ int run(CheckOptions o) {
       "  top-surface deviation   mean %.4f  p95 %.4f  max %.4f mm  (%zu of %zu samples covered)\n",
       f->deviation_mean, f->deviation_p95, f->deviation_max, f->covered_samples,
       f->surface_samples);
-  std::printf("  layer thickness         %.3f - %.3f mm\n", f->thickness_min, f->thickness_max);
+  std::printf(
+      "  layer thickness         %.3f - %.3f mm  (thinnest at x %.2f y %.2f z %.2f, thickest "
+      "at x %.2f y %.2f z %.2f)\n",
+      f->thickness_min, f->thickness_max, f->thickness_min_at.x(), f->thickness_min_at.y(),
+      f->thickness_min_at.z(), f->thickness_max_at.x(), f->thickness_max_at.y(),
+      f->thickness_max_at.z());
   std::printf("  steepest extrusion      %.1f deg\n", f->steepest_deg);
   std::printf("  collisions              %zu", f->collisions);
   if (f->collisions > 0)

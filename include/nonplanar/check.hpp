@@ -62,6 +62,7 @@ struct CheckFigures {
   std::size_t surface_samples = 0, covered_samples = 0;
   double deviation_mean = 0, deviation_p95 = 0, deviation_max = 0;
   double thickness_min = 0, thickness_max = 0;
+  Vec3 thickness_min_at{0, 0, 0}, thickness_max_at{0, 0, 0};  ///< the extrusion samples
   double steepest_deg = 0;
   std::size_t collisions = 0;
   Vec3 first_collision{0, 0, 0};

@@ -35,16 +35,21 @@ struct LayerParams {
   StackOptimizer optimizer = StackOptimizer::lbfgs;
   int max_iterations = 100;
   double grid_step = 0.5;  ///< quadrature and check spacing over the footprint
+  /// The stack's top lies on the patch's facets (fit + faceted residual, see
+  /// src/layers/top_residual.hpp) rather than on the smooth fit through them.
+  bool faceted_top = true;
 };
 
 /// The curved layers of one patch.
 struct LayerStack {
   int patch = -1;
-  double c = 0;                       ///< the bottom plane, a planar layer boundary
-  int layers = 0;                     ///< N
-  double T_bottom = 0;                ///< layer coordinate of the plane c
-  std::vector<HeightField> surfaces;  ///< S_0 (top) … S_N (plane), same knots and weights
-  Vec2 xy_min{0, 0}, xy_max{0, 0};    ///< the patch's footprint
+  double c = 0;         ///< the bottom plane, a planar layer boundary
+  int layers = 0;       ///< N
+  double T_bottom = 0;  ///< layer coordinate of the plane c
+  /// S_0 (top) … S_N (plane), same knots and weights. With LayerParams::faceted_top the
+  /// printed layers add (N − i)/N times the top's faceted residual to these.
+  std::vector<HeightField> surfaces;
+  Vec2 xy_min{0, 0}, xy_max{0, 0};  ///< the patch's footprint
   // Figures over the patch, mm and degrees (after optimisation).
   double thickness_min = 0, thickness_max = 0;
   double max_slope_deg = 0;

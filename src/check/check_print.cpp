@@ -20,6 +20,11 @@ namespace nonplanar {
 namespace {
 
 constexpr double kNear = 0.6;  // neighbourhood for plane fits, mm
+// Least spread across the points for a plane fit (standard deviation), mm. Lines of one
+// layer lie 0.45 mm apart; a sparse infill line with one point of another beside it spreads
+// more than this but tilts a plane about the line (on the sphere's 30° rim that read a
+// 0.22 mm layer as 0.30 mm), so plane_z also wants three points off the main line.
+constexpr double kSpread = 0.1;
 
 struct Pt {
   Vec3 p;
@@ -110,7 +115,8 @@ class PointGrid {
 // nearest point's height is used.
 // With `line`, the nearest point is returned there (when within 0.2 mm) and its height is
 // not used: the caller handles a layer that is only a line here.
-bool plane_z(const PointGrid& g, int layer, double x, double y, double* z, Vec3* line = nullptr) {
+bool plane_z(const PointGrid& g, int layer, double x, double y, double* z, Vec3* line = nullptr,
+             bool strict = false) {
   Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
   Eigen::Vector3d b = Eigen::Vector3d::Zero();
   int n = 0;
@@ -134,8 +140,27 @@ bool plane_z(const PointGrid& g, int layer, double x, double y, double* z, Vec3*
   const double mx = A(0, 1) / n, my = A(0, 2) / n;
   Eigen::Matrix2d cov;
   cov << A(1, 1) / n - mx * mx, A(1, 2) / n - mx * my, A(1, 2) / n - mx * my, A(2, 2) / n - my * my;
-  if (Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(cov).eigenvalues()[0] < 0.05 * 0.05)
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(cov);
+  const double spread = strict ? kSpread : 0.5 * kSpread;
+  if (eig.eigenvalues()[0] < spread * spread)
     return !line && close;  // a slope makes a farther point's height misleading
+  // One line and a stray point or two beside it spread enough, but tilt the plane about the
+  // line: `strict` wants at least three points off the points' main line (by 0.2 mm: the
+  // stray point also tilts the principal axis, so the line's own ends sit up to 0.1 mm off
+  // it). Thickness asks for it; the deviation keeps a tilted plane, which on a 27° slope
+  // is still nearer the layer than the nearest point's height.
+  if (!strict) {
+    *z = A.ldlt().solve(b)[0];
+    return true;
+  }
+  const Vec2 across = eig.eigenvectors().col(0);
+  int off = 0;
+  g.near(x, y, layer, [&](const Pt& q) {
+    const double dx = q.p.x() - x, dy = q.p.y() - y;
+    if (dx * dx + dy * dy > kNear * kNear) return;
+    off += std::abs((dx - mx) * across.x() + (dy - my) * across.y()) > 2 * kSpread;
+  });
+  if (off < 3) return !line && close;
   *z = A.ldlt().solve(b)[0];
   return true;
 }
@@ -308,8 +333,20 @@ Expected<CheckFigures> check_print(const std::vector<PrintMove>& moves, const Tr
       double below = 0;
       double t = q.p.z();
       Vec3 r(1e300, 0, 0);
-      if (q.layer > 0 && plane_z(*grid, q.layer - 1, q.p.x(), q.p.y(), &below, &r)) {
-        t = q.p.z() - below;
+      const bool fits =
+          q.layer > 0 && plane_z(*grid, q.layer - 1, q.p.x(), q.p.y(), &below, &r, true);
+      // Nothing under it within 0.2 mm (a bridge, or a solid layer over sparse infill): a
+      // plane through lines farther away would be an extrapolation, not a thickness.
+      if (fits && (r.head<2>() - q.p.head<2>()).squaredNorm() > 0.2 * 0.2) continue;
+      if (fits) {
+        // This layer's height from the same kind of plane: where a curved stack bends (the
+        // rim of a patch) a plane through lines 0.45 mm apart misreads a layer's height by a
+        // few hundredths of a mm, and consecutive layers bend alike, so the two misreadings
+        // cancel in the difference. A single line here: its own height.
+        double here = q.p.z();
+        Vec3 line;
+        if (!plane_z(*grid, q.layer, q.p.x(), q.p.y(), &here, &line, true)) here = q.p.z();
+        t = here - below;
       } else if (q.layer > 0) {
         // The layer below is a single line here (the edge of a region): on a slope its
         // nearest point's height is off by the slope times the distance, so measure at that
@@ -318,12 +355,12 @@ Expected<CheckFigures> check_print(const std::vector<PrintMove>& moves, const Tr
         double above = 0;
         Vec3 unused;
         if (r.x() > 1e299 || (r.head<2>() - q.p.head<2>()).squaredNorm() > 0.2 * 0.2 ||
-            !plane_z(*grid, q.layer, r.x(), r.y(), &above, &unused))
+            !plane_z(*grid, q.layer, r.x(), r.y(), &above, &unused, true))
           continue;
         t = above - r.z();
       }
-      f.thickness_min = std::min(f.thickness_min, t);
-      f.thickness_max = std::max(f.thickness_max, t);
+      if (t < f.thickness_min) f.thickness_min = t, f.thickness_min_at = q.p;
+      if (t > f.thickness_max) f.thickness_max = t, f.thickness_max_at = q.p;
     }
     if (f.thickness_min > f.thickness_max) f.thickness_min = f.thickness_max = 0;
   }

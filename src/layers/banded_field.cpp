@@ -42,7 +42,8 @@ Band::Basis Band::basis(double x, double y) const {
       W += r;
     }
   for (int k = 0; k < (s.p + 1) * (s.q + 1); ++k) b.R[k] /= W;
-  b.top = raw_surface(b, 0);
+  b.raw0 = raw_surface(b, 0);
+  b.top = facets.empty() ? b.raw0 : facets.height(x, y);
   return b;
 }
 
@@ -58,7 +59,14 @@ double Band::raw_surface(const Basis& b, int i) const {
 
 double Band::surface(const Basis& b, int i) const {
   const double z = raw_surface(b, i);
-  if (top_lo >= top_hi || i == N) return z;
+  if (i == N) return z;
+  if (!facets.empty()) {
+    // S_0 = H; the layers under it keep the control heights' proportions. Where the fit fell
+    // to the plane (off the patch) there are no proportions left: split evenly.
+    if (b.raw0 - c < 0.5 * (b.top - c)) return c + (b.top - c) * (N - i) / N;
+    return c + (z - c) * (b.top - c) / (b.raw0 - c);
+  }
+  if (top_lo >= top_hi) return z;
   const double z0 = b.top;
   if (z0 >= top_lo && z0 <= top_hi) return z;
   // Off the patch the top swings out of its range: clamp it, and scale the stack under it

@@ -5,12 +5,14 @@
 // the stack surfaces at (x, y)); above the top S_0, δ_b fades to 0 over L_rec with a
 // smoothstep; below c it is 0. β_b ∈ [0, 1] is a uniform cubic B-spline over a raster
 // (C²), exactly 1 on the patch, 0 beyond the blend distance; where Σβ > 1 the β are scaled
-// to sum to 1, so T stays a convex combination of increasing functions of z.
+// to sum to 1, so T stays a convex combination of increasing functions of z. With a faceted
+// top H (faceted_top.hpp), S_0 = H and the layers keep the control heights' proportions.
 #pragma once
 
 #include <Eigen/Core>
 #include <vector>
 
+#include "layers/faceted_top.hpp"
 #include "layers/patch_raster.hpp"
 #include "layers/planar_layers.hpp"
 #include "nonplanar/layers.hpp"
@@ -27,6 +29,7 @@ struct Band {
   /// patch the fit is held only by its smoothness term and can swing; there S_0 is clamped
   /// to this range and the layers under it scaled alike, so the blend zone sees a tame stack.
   double top_lo = 0, top_hi = 0;
+  FacetedTop facets;  ///< the top on the facets; empty: the top is the fit (tamed by top_lo)
   // β: cubic B-spline control values on a grid (origin = node (0, 0)).
   Vec2 blend_origin{0, 0};
   double blend_cell = 0.5;
@@ -37,12 +40,13 @@ struct Band {
   struct Basis {
     int i0 = 0, j0 = 0;
     double R[64];
-    double top = 0;  ///< raw S_0 here (surface() tames the others by it)
+    double raw0 = 0;  ///< S_0 as the control heights give it
+    double top = 0;   ///< S_0 before taming: H with facets, else raw0
   };
   Basis basis(double x, double y) const;
   /// S_i at the basis's point (off the patch: tamed, see top_lo).
   double surface(const Basis& b, int i) const;
-  /// S_i as the control heights give it.
+  /// S_i as the control heights give it (no facets, no taming).
   double raw_surface(const Basis& b, int i) const;
   /// S_0 … S_N at (x, y) into S (size N + 1).
   void heights(double x, double y, double* S) const;

@@ -49,18 +49,35 @@ struct Figures {
 };
 
 // Thickness and slope over the patch's samples; rise of each layer within the block radius
-// on a grid of about 1 mm.
-Figures measure(const StackGrid& g, const Eigen::MatrixXd& Z, const LayerParams& p) {
+// on a grid of about 1 mm. H, dH: the faceted top and its gradient at the samples (empty:
+// the top is the fit), with the layers between it and the plane c in the control heights'
+// proportions, as Band::surface places them.
+Figures measure(const StackGrid& g, const Eigen::MatrixXd& Z, const LayerParams& p,
+                const std::vector<double>& H, const std::vector<Vec2>& dH, double c) {
   Figures f;
   const int L = static_cast<int>(Z.rows());
   const int n = static_cast<int>(g.xy.size());
   std::vector<std::vector<double>> S(L, std::vector<double>(n));
   for (int k = 0; k < n; ++k) {
+    double s0 = 0, s0x = 0, s0y = 0;
     for (int i = 0; i < L; ++i) {
       double s = 0, sx = 0, sy = 0;
       for (int a = 0; a < g.m; ++a) {
         const double z = Z(i, g.control(k, a));
         s += g.R[k * g.m + a] * z, sx += g.Rx[k * g.m + a] * z, sy += g.Ry[k * g.m + a] * z;
+      }
+      if (i == 0) s0 = s, s0x = sx, s0y = sy;
+      if (!H.empty() && i + 1 < L) {
+        const double d = H[k] - c, d0 = s0 - c;
+        if (d0 < 0.5 * d) {  // even split
+          const double w = static_cast<double>(L - 1 - i) / (L - 1);
+          s = c + d * w, sx = dH[k].x() * w, sy = dH[k].y() * w;
+        } else {  // S_i = c + (s − c)·q, q = (H − c)/(s_0 − c)
+          const double q = d / d0;
+          const double qx = (dH[k].x() * d0 - d * s0x) / (d0 * d0);
+          const double qy = (dH[k].y() * d0 - d * s0y) / (d0 * d0);
+          sx = sx * q + (s - c) * qx, sy = sy * q + (s - c) * qy, s = c + (s - c) * q;
+        }
       }
       S[i][k] = s;
       if (g.on_patch[k]) f.slope = std::max(f.slope, std::atan(std::hypot(sx, sy)) / kDeg);
@@ -125,13 +142,23 @@ StackResult build_stack(const TriangleMesh& mesh, const Patch& patch, int patch_
   build_stack_grid(coarse, top, coarse_step, raster.mask, raster.origin, raster.cell, raster.nx,
                    raster.ny);
 
+  // The top follows the facets, on a raster fine enough that its bilinear interpolation is
+  // within a few µm of them. (This one covers the grid; the band's, built last, covers the
+  // whole blend zone.)
+  FacetedTop facets;
+  if (p.faceted_top) facets = faceted_top(mesh, patch, 0.1, 1.0);
   // Heights of the top over the whole rectangle (the stack must be valid where it blends).
   const int n = static_cast<int>(grid.xy.size());
-  std::vector<double> top_z(n);
+  std::vector<double> top_z(n), top_tan(n, 0.0), H(facets.empty() ? 0 : n);
+  std::vector<Vec2> dH(H.size());
+  for (std::size_t k = 0; k < H.size(); ++k) {
+    H[k] = facets.height(grid.xy[k].x(), grid.xy[k].y());
+    dH[k] = facets.gradient(grid.xy[k].x(), grid.xy[k].y());
+  }
   double zmin = 1e300, zmax = -1e300, on_sum = 0, top_slope = 0;
   int on_count = 0;
   for (int k = 0; k < n; ++k) {
-    top_z[k] = top.height(grid.xy[k].x(), grid.xy[k].y());
+    top_z[k] = H.empty() ? top.height(grid.xy[k].x(), grid.xy[k].y()) : H[k];
     // Relief over the patch itself: off it, the fit is held only by its smoothness term and
     // may swing (the blend check below judges the layers there, in the material).
     if (grid.on_patch[k]) {
@@ -140,10 +167,13 @@ StackResult build_stack(const TriangleMesh& mesh, const Patch& patch, int patch_
     }
     if (grid.on_patch[k]) {
       on_sum += top_z[k], ++on_count;
-      top_slope = std::max(top_slope,
-                           std::atan(top.gradient(grid.xy[k].x(), grid.xy[k].y()).norm()) / kDeg);
+      const Vec2 g = H.empty() ? top.gradient(grid.xy[k].x(), grid.xy[k].y()) : dH[k];
+      top_tan[k] = g.norm();
+      top_slope = std::max(top_slope, std::atan(top_tan[k]) / kDeg);
     }
   }
+  // The facets' own range (grid samples can miss a low vertex at the rim).
+  if (!facets.empty()) zmin = std::min(zmin, facets.h_lo), zmax = std::max(zmax, facets.h_hi);
   if (on_count == 0) {
     out.failure = "patch covers no sample of its grid";
     return out;
@@ -168,12 +198,40 @@ StackResult build_stack(const TriangleMesh& mesh, const Patch& patch, int patch_
         relief, d_req);
     return out;
   }
-  st.c = p.first_layer_height + k * p.layer_height;
+  // N for a plane c: about h thick on average, within the thickness limits with a margin.
+  const double mean_top = on_sum / on_count;
+  const auto count_for = [&](double c, bool fewest) {
+    const int lo = static_cast<int>(std::ceil((zmax - c) / (0.97 * p.max_layer_height)));
+    const int hi = static_cast<int>(std::floor((zmin - c) / (1.03 * p.min_layer_height)));
+    const int N = fewest ? lo : static_cast<int>(std::lround((mean_top - c) / p.layer_height));
+    return std::min(std::max(N, lo), hi);
+  };
+  // The nozzle tip's flat reaches over the earlier layer uphill: at slope θ, a layer thinner
+  // than (r + a check cell's half-diagonal)·tan θ − h/2 fires DESIGN.md §3's collision test
+  // (the sphere's rim: 29.7° and 0.11 mm). With the even stack a layer is (S_0 − c)/N thick
+  // and no steeper than the top, so take the highest plane c, and there the most layers, that
+  // keep every patch sample clear; when none does, keep the first choice for the gate to judge.
+  const auto tip_clear = [&](double c, int N) {
+    if (N < 1) return false;
+    for (int kk = 0; kk < n; ++kk)
+      if (grid.on_patch[kk] &&
+          (top_z[kk] - c) / N < (p.nozzle_tip_radius + 0.15) * top_tan[kk] - 0.5 * p.layer_height)
+        return false;
+    return true;
+  };
+  double k_pick = k;
+  int N = count_for(p.first_layer_height + k * p.layer_height, false);
+  for (double kk = k; kk >= 0 && kk > k - 200; --kk) {
+    const double c = p.first_layer_height + kk * p.layer_height;
+    const int a = count_for(c, false), b = count_for(c, true);
+    if (tip_clear(c, a) || tip_clear(c, b)) {
+      k_pick = kk, N = tip_clear(c, a) ? a : b;
+      break;
+    }
+  }
+  st.c = p.first_layer_height + k_pick * p.layer_height;
   st.T_bottom = planar.T(st.c);
-  const double D_min = zmin - st.c, D_max = zmax - st.c, D_mean = on_sum / on_count - st.c;
-  int N = static_cast<int>(std::lround(D_mean / p.layer_height));
-  N = std::max(N, static_cast<int>(std::ceil(D_max / (0.97 * p.max_layer_height))));
-  N = std::min(N, static_cast<int>(std::floor(D_min / (1.03 * p.min_layer_height))));
+  const double D_min = zmin - st.c, D_max = zmax - st.c;
   if (N < 1 || D_max / N > p.max_layer_height || D_min / N < p.min_layer_height || N > 500) {
     out.failure = fmt2(
         "relief %.2f mm cannot be split into layers within the thickness limits "
@@ -248,7 +306,7 @@ StackResult build_stack(const TriangleMesh& mesh, const Patch& patch, int patch_
       for (int j = 0; j < nc; ++j) best(i, j) = x[(i - 1) * nc + j];
   }
   st.cost_after = printability_cost(coarse, best, terms, nullptr);
-  Figures f = measure(grid, best, p);
+  Figures f = measure(grid, best, p, H, dH, st.c);
   const auto ok = [&](const Figures& g) {
     return g.t_min >= p.min_layer_height - 1e-6 && g.t_max <= p.max_layer_height + 1e-6 &&
            g.slope <= p.max_angle_deg;
@@ -261,7 +319,7 @@ StackResult build_stack(const TriangleMesh& mesh, const Patch& patch, int patch_
       for (int j = 0; j < nc; ++j)
         even(i, j) = (1 - static_cast<double>(i) / N) * top.surface.points[j].z() +
                      static_cast<double>(i) / N * st.c;
-    const Figures fe = measure(grid, even, p);
+    const Figures fe = measure(grid, even, p, H, dH, st.c);
     if (ok(fe)) {
       best = even, f = fe;
       st.cost_after = printability_cost(coarse, even, terms, nullptr);
@@ -296,6 +354,7 @@ StackResult build_stack(const TriangleMesh& mesh, const Patch& patch, int patch_
   b.c = st.c;
   b.N = N;
   b.T_bottom = st.T_bottom;
+
   // The top's range over the patch bounds it elsewhere (see Band::top_lo); a hair of slack
   // so points between grid samples on the patch are never touched.
   b.top_lo = zmin - 0.01, b.top_hi = zmax + 0.01;
@@ -308,6 +367,8 @@ StackResult build_stack(const TriangleMesh& mesh, const Patch& patch, int patch_
   const PatchRaster wide =
       rasterize_patch(mesh, patch, std::max(0.25, p.grid_step / 2), blend + 2.0);
   set_blend(b, wide, blend);
+  // β reaches two of its cells past its raster.
+  if (!facets.empty()) b.facets = faceted_top(mesh, patch, 0.1, blend + 2.0 + 3 * wide.cell);
   return out;
 }
 

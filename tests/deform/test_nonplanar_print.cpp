@@ -52,6 +52,9 @@ void expect_good(const Outcome& o, std::size_t stacks) {
   EXPECT_LE(o.figures.steepest_deg, lp.max_angle_deg + 0.5);
   EXPECT_GE(o.result.thickness_min, lp.min_layer_height - 1e-3);
   EXPECT_LE(o.result.thickness_max, lp.max_layer_height + 1e-3);
+  // ... and as `check` reads them back from the G-code alone.
+  EXPECT_GE(o.figures.thickness_min, lp.min_layer_height - 1e-3);
+  EXPECT_LE(o.figures.thickness_max, lp.max_layer_height + 1e-3);
   EXPECT_LT(o.figures.outside_fraction, 0.01);
   for (const char* tag : {";TYPE:External perimeter", ";TYPE:Top solid infill", ";LAYER_CHANGE",
                           ";HEIGHT:", ";WIDTH:"})
@@ -137,6 +140,20 @@ TEST(NonplanarPrint, SharedFoilCutter) {
   const Outcome o = run(m->mesh);
   expect_good(o, 1);
   EXPECT_GT(o.figures.deviation_p95, 0.0);
+}
+
+// A coarse mesh (1280 facets): the smooth fit through its vertices is 33° steep at the rim
+// and up to 0.04 mm above the facets, so it fell back to planar (p95 0.077 mm). The stack's
+// top now lies on the facets (layers/faceted_top.hpp), and its plane sits deep enough that
+// the 30° layers at the rim are thick enough for the nozzle's flat.
+TEST(NonplanarPrint, SharedSphereTopFollowsItsFacets) {
+  const auto dir = test::shared_models();
+  if (dir.empty()) GTEST_SKIP() << "../shared/models not present";
+  auto m = load_mesh(dir / "np_prusa_sphere.stl", {}, {});
+  ASSERT_TRUE(m);
+  const Outcome o = run(m->mesh);
+  expect_good(o, 1);
+  EXPECT_LE(o.figures.deviation_p95, 0.01);
 }
 
 TEST(NonplanarPrint, FlatTopsSlicePlanarWithANotice) {

@@ -1,0 +1,46 @@
+// The stack's top on the facets: H(x, y), the height of a patch's triangles, carried outward
+// past its rim.
+//
+// Notation: S_f the fitted NURBS top; H the facets' height (on the patch) or its continuation
+// (off it); c the stack's bottom plane; S_i the stack's layers, S_0 = H, S_N = c.
+//
+// Why: the fit is smooth, the mesh is not. On a coarse mesh (the 1280-facet sphere) the fit
+// through the vertices sits up to 0.04 mm above the facets and is steeper than any of them
+// at the rim (33° against 29.7°). With S_0 = H the top layer lies on the printable facets
+// themselves, whose slopes are below max_angle by the patch's definition, and the layers
+// under it keep the fitted stack's proportions: S_i = c + (S_i,fit − c)·(H − c)/(S_0,fit − c).
+// Off the patch the fit is held only by its smoothness term and can swing by millimetres
+// (17 mm beside the sphere's rim); there H carries the rim's heights outward, so the blend
+// zone sees a tame top that no clamp has to bend.
+#pragma once
+
+#include <vector>
+
+#include "nonplanar/analysis.hpp"
+
+namespace nonplanar::layers {
+
+struct FacetedTop {
+  Vec2 origin{0, 0};  ///< node (0, 0), mm
+  double cell = 0.1;  ///< node spacing, mm
+  int nx = 0, ny = 0;
+  std::vector<double> h;      ///< nx·ny node heights H, mm (node (i, j) at index i·ny + j)
+  double h_lo = 0, h_hi = 0;  ///< the patch's height range (its vertices), mm
+  bool empty() const { return h.empty(); }
+  /// H at (x, y), bilinear between nodes, mm. Only meaningful inside the raster.
+  double height(double x, double y) const;
+  /// (∂H/∂x, ∂H/∂y) of the bilinear interpolant at (x, y).
+  Vec2 gradient(double x, double y) const;
+  /// Whether (x, y) lies inside the raster.
+  bool covers(double x, double y) const;
+};
+
+/// H on a raster of `cell` mm (coarser for huge patches: at most about 2 million nodes)
+/// covering the patch's XY box grown by `pad` mm. Nodes inside a patch triangle (in XY) take
+/// that triangle's height; the first ring outside continues its neighbours' triangles'
+/// planes, within [h_lo, h_hi]; each later ring takes the mean of its 8 neighbours from
+/// earlier rings, and 20 Gauss–Seidel sweeps then smooth the ridges where rings from
+/// different stretches of the rim meet (H levels off away from the rim).
+FacetedTop faceted_top(const TriangleMesh& mesh, const Patch& patch, double cell, double pad);
+
+}  // namespace nonplanar::layers
