@@ -142,4 +142,69 @@ FacetedTop faceted_top(const TriangleMesh& mesh, const Patch& patch, double cell
   return t;
 }
 
+FacetSamples facet_samples(const TriangleMesh& mesh, const Patch& patch,
+                           const std::vector<Vec2>& xy, const std::vector<char>& want) {
+  FacetSamples out;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  out.h.assign(xy.size(), nan);
+  out.slope.assign(xy.size(), Vec2(nan, nan));
+  out.h_lo = std::numeric_limits<double>::infinity(), out.h_hi = -out.h_lo;
+  for (int f : patch.faces)
+    for (int v : mesh.faces[f]) {
+      out.h_lo = std::min(out.h_lo, mesh.vertices[v].z());
+      out.h_hi = std::max(out.h_hi, mesh.vertices[v].z());
+    }
+  if (patch.faces.empty()) return out;
+  // Triangles binned by their XY boxes on buckets of about four triangles' size.
+  const Vec2 lo = patch.xy_min, ext = (patch.xy_max - patch.xy_min).cwiseMax(Vec2(1e-6, 1e-6));
+  const double b =
+      std::max(0.5, 2 * std::sqrt(ext.x() * ext.y() / static_cast<double>(patch.faces.size())));
+  const int bx = static_cast<int>(ext.x() / b) + 1, by = static_cast<int>(ext.y() / b) + 1;
+  std::vector<std::vector<int>> bucket(static_cast<std::size_t>(bx) * by);
+  const auto clampi = [](double v, int n) { return std::clamp(static_cast<int>(v), 0, n - 1); };
+  for (int f : patch.faces) {
+    const auto& t = mesh.faces[f];
+    const Vec3 &a = mesh.vertices[t[0]], &c1 = mesh.vertices[t[1]], &c2 = mesh.vertices[t[2]];
+    const int i0 = clampi((std::min({a.x(), c1.x(), c2.x()}) - lo.x()) / b, bx);
+    const int i1 = clampi((std::max({a.x(), c1.x(), c2.x()}) - lo.x()) / b, bx);
+    const int j0 = clampi((std::min({a.y(), c1.y(), c2.y()}) - lo.y()) / b, by);
+    const int j1 = clampi((std::max({a.y(), c1.y(), c2.y()}) - lo.y()) / b, by);
+    for (int i = i0; i <= i1; ++i)
+      for (int j = j0; j <= j1; ++j) bucket[static_cast<std::size_t>(i) * by + j].push_back(f);
+  }
+  for (std::size_t k = 0; k < xy.size(); ++k) {
+    if (!want[k]) continue;
+    const double x = xy[k].x(), y = xy[k].y();
+    const int ci = clampi((x - lo.x()) / b, bx), cj = clampi((y - lo.y()) / b, by);
+    double best = -std::numeric_limits<double>::infinity(), near_d = 1e300;
+    int inside = -1, nearest = -1;
+    for (int i = std::max(0, ci - 1); i <= std::min(bx - 1, ci + 1); ++i)
+      for (int j = std::max(0, cj - 1); j <= std::min(by - 1, cj + 1); ++j)
+        for (int f : bucket[static_cast<std::size_t>(i) * by + j]) {
+          const auto& t = mesh.faces[f];
+          const Vec3 &a = mesh.vertices[t[0]], &p1 = mesh.vertices[t[1]], &p2 = mesh.vertices[t[2]];
+          const double d =
+              (p1.x() - a.x()) * (p2.y() - a.y()) - (p2.x() - a.x()) * (p1.y() - a.y());
+          if (d == 0) continue;
+          const double l1 = ((x - a.x()) * (p2.y() - a.y()) - (p2.x() - a.x()) * (y - a.y())) / d;
+          const double l2 = ((p1.x() - a.x()) * (y - a.y()) - (x - a.x()) * (p1.y() - a.y())) / d;
+          const double z = a.z() + l1 * (p1.z() - a.z()) + l2 * (p2.z() - a.z());
+          if (l1 >= -1e-9 && l2 >= -1e-9 && l1 + l2 <= 1 + 1e-9) {
+            if (z > best) best = z, inside = f;
+            continue;
+          }
+          const Vec2 g = (a + p1 + p2).head<2>() / 3.0 - xy[k];
+          if (g.squaredNorm() < near_d) near_d = g.squaredNorm(), nearest = f;
+        }
+    const int f = inside >= 0 ? inside : nearest;
+    if (f < 0) continue;
+    const auto& t = mesh.faces[f];
+    const Vec3 &a = mesh.vertices[t[0]], &p1 = mesh.vertices[t[1]], &p2 = mesh.vertices[t[2]];
+    const Vec3 nrm = (p1 - a).cross(p2 - a);
+    out.slope[k] = Vec2(-nrm.x() / nrm.z(), -nrm.y() / nrm.z());
+    out.h[k] = a.z() + out.slope[k].dot(xy[k] - a.head<2>());
+  }
+  return out;
+}
+
 }  // namespace nonplanar::layers

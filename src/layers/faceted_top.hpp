@@ -43,4 +43,16 @@ struct FacetedTop {
 /// different stretches of the rim meet (H levels off away from the rim).
 FacetedTop faceted_top(const TriangleMesh& mesh, const Patch& patch, double cell, double pad);
 
+/// The facets' heights and slopes at points (x, y), without a raster: for each point with
+/// want[k], the highest patch triangle containing it in XY, or else the nearest one (by
+/// centroid, within a few mm) extended as a plane. Points with !want[k], or no triangle
+/// near, get NaN. Also the patch's vertex height range. mm; slopes dz/dx, dz/dy.
+struct FacetSamples {
+  std::vector<double> h;
+  std::vector<Vec2> slope;
+  double h_lo = 0, h_hi = 0;
+};
+FacetSamples facet_samples(const TriangleMesh& mesh, const Patch& patch,
+                           const std::vector<Vec2>& xy, const std::vector<char>& want);
+
 }  // namespace nonplanar::layers

@@ -142,18 +142,20 @@ StackResult build_stack(const TriangleMesh& mesh, const Patch& patch, int patch_
   build_stack_grid(coarse, top, coarse_step, raster.mask, raster.origin, raster.cell, raster.nx,
                    raster.ny);
 
-  // The top follows the facets, on a raster fine enough that its bilinear interpolation is
-  // within a few µm of them. (This one covers the grid; the band's, built last, covers the
-  // whole blend zone.)
-  FacetedTop facets;
-  if (p.faceted_top) facets = faceted_top(mesh, patch, 0.1, 1.0);
   // Heights of the top over the whole rectangle (the stack must be valid where it blends).
+  // It follows the facets (the band's raster, built last, carries them past the rim).
   const int n = static_cast<int>(grid.xy.size());
-  std::vector<double> top_z(n), top_tan(n, 0.0), H(facets.empty() ? 0 : n);
-  std::vector<Vec2> dH(H.size());
-  for (std::size_t k = 0; k < H.size(); ++k) {
-    H[k] = facets.height(grid.xy[k].x(), grid.xy[k].y());
-    dH[k] = facets.gradient(grid.xy[k].x(), grid.xy[k].y());
+  std::vector<double> top_z(n), top_tan(n, 0.0), H;
+  std::vector<Vec2> dH;
+  FacetSamples fs;
+  if (p.faceted_top) {
+    fs = facet_samples(mesh, patch, grid.xy, grid.on_patch);
+    H.resize(n), dH.resize(n);
+    for (int k = 0; k < n; ++k) {
+      const bool ok = std::isfinite(fs.h[k]) && fs.slope[k].allFinite();
+      H[k] = ok ? fs.h[k] : top.height(grid.xy[k].x(), grid.xy[k].y());
+      dH[k] = ok ? fs.slope[k] : top.gradient(grid.xy[k].x(), grid.xy[k].y());
+    }
   }
   double zmin = 1e300, zmax = -1e300, on_sum = 0, top_slope = 0;
   int on_count = 0;
@@ -173,7 +175,7 @@ StackResult build_stack(const TriangleMesh& mesh, const Patch& patch, int patch_
     }
   }
   // The facets' own range (grid samples can miss a low vertex at the rim).
-  if (!facets.empty()) zmin = std::min(zmin, facets.h_lo), zmax = std::max(zmax, facets.h_hi);
+  if (p.faceted_top) zmin = std::min(zmin, fs.h_lo), zmax = std::max(zmax, fs.h_hi);
   if (on_count == 0) {
     out.failure = "patch covers no sample of its grid";
     return out;
@@ -207,15 +209,17 @@ StackResult build_stack(const TriangleMesh& mesh, const Patch& patch, int patch_
     return std::min(std::max(N, lo), hi);
   };
   // The nozzle tip's flat reaches over the earlier layer uphill: at slope θ, a layer thinner
-  // than (r + a check cell's half-diagonal)·tan θ − h/2 fires DESIGN.md §3's collision test
-  // (the sphere's rim: 29.7° and 0.11 mm). With the even stack a layer is (S_0 − c)/N thick
-  // and no steeper than the top, so take the highest plane c, and there the most layers, that
-  // keep every patch sample clear; when none does, keep the first choice for the gate to judge.
+  // than r·tan θ − h/2 fires DESIGN.md §3's collision test (the sphere's rim: 29.7° and
+  // 0.11 mm), and the test's 0.2 mm cells reach a little farther; 0.1 mm more than r keeps
+  // the sphere clear (0.05 did not, and left `check` reading 0.08 mm layers on FoilCutter).
+  // With the even stack a layer is (S_0 − c)/N thick and no steeper than the top, so take
+  // the highest plane c, and there the most layers, that keep every patch sample clear; when
+  // none does, keep the first choice for the gate to judge.
   const auto tip_clear = [&](double c, int N) {
     if (N < 1) return false;
     for (int kk = 0; kk < n; ++kk)
       if (grid.on_patch[kk] &&
-          (top_z[kk] - c) / N < (p.nozzle_tip_radius + 0.15) * top_tan[kk] - 0.5 * p.layer_height)
+          (top_z[kk] - c) / N < (p.nozzle_tip_radius + 0.1) * top_tan[kk] - 0.5 * p.layer_height)
         return false;
     return true;
   };
@@ -368,7 +372,7 @@ StackResult build_stack(const TriangleMesh& mesh, const Patch& patch, int patch_
       rasterize_patch(mesh, patch, std::max(0.25, p.grid_step / 2), blend + 2.0);
   set_blend(b, wide, blend);
   // β reaches two of its cells past its raster.
-  if (!facets.empty()) b.facets = faceted_top(mesh, patch, 0.1, blend + 2.0 + 3 * wide.cell);
+  if (p.faceted_top) b.facets = faceted_top(mesh, patch, 0.1, blend + 2.0 + 3 * wide.cell);
   return out;
 }
 
