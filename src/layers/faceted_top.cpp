@@ -175,6 +175,8 @@ FacetSamples facet_samples(const TriangleMesh& mesh, const Patch& patch,
   for (std::size_t k = 0; k < xy.size(); ++k) {
     if (!want[k]) continue;
     const double x = xy[k].x(), y = xy[k].y();
+    if (x < lo.x() - b || y < lo.y() - b || x > lo.x() + ext.x() + b || y > lo.y() + ext.y() + b)
+      continue;  // no triangle near
     const int ci = clampi((x - lo.x()) / b, bx), cj = clampi((y - lo.y()) / b, by);
     double best = -std::numeric_limits<double>::infinity(), near_d = 1e300;
     int inside = -1, nearest = -1;

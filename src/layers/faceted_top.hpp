@@ -45,8 +45,9 @@ FacetedTop faceted_top(const TriangleMesh& mesh, const Patch& patch, double cell
 
 /// The facets' heights and slopes at points (x, y), without a raster: for each point with
 /// want[k], the highest patch triangle containing it in XY, or else the nearest one (by
-/// centroid, within a few mm) extended as a plane. Points with !want[k], or no triangle
-/// near, get NaN. Also the patch's vertex height range. mm; slopes dz/dx, dz/dy.
+/// centroid, among those within a bucket of about four triangles' size) extended as a
+/// plane. Points with !want[k], or farther than a bucket from the patch's box, get NaN. Also the
+/// patch's vertex height range. mm; slopes dz/dx, dz/dy.
 struct FacetSamples {
   std::vector<double> h;
   std::vector<Vec2> slope;

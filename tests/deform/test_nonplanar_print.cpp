@@ -156,6 +156,13 @@ TEST(NonplanarPrint, SharedSphereTopFollowsItsFacets) {
   EXPECT_LE(o.figures.deviation_p95, 0.01);
 }
 
+// The same on a coarse sphere the test makes (1280 facets, 31 mm across).
+TEST(NonplanarPrint, CoarseIcosphereTopFollowsItsFacets) {
+  const Outcome o = run(test::icosphere({0, 0, 15.5}, 15.5, 3));
+  expect_good(o, 1);
+  EXPECT_LE(o.figures.deviation_p95, 0.01);
+}
+
 TEST(NonplanarPrint, FlatTopsSlicePlanarWithANotice) {
   const Outcome o = run(test::box({0, 0, 0}, {20, 20, 10}));
   EXPECT_FALSE(o.result.nonplanar);
