@@ -33,7 +33,8 @@ bool FacetedTop::covers(double x, double y) const {
   return fx >= 0 && fy >= 0 && fx <= nx - 1 && fy <= ny - 1;
 }
 
-FacetedTop faceted_top(const TriangleMesh& mesh, const Patch& patch, double cell, double pad) {
+FacetedTop faceted_top(const TriangleMesh& mesh, const Patch& patch, double cell, double pad,
+                       double max_slope) {
   FacetedTop t;
   // Keep the raster under about 2 million nodes (16 MB) however large the patch.
   const Vec2 size = patch.xy_max - patch.xy_min + Vec2(2 * pad, 2 * pad);
@@ -113,7 +114,7 @@ FacetedTop faceted_top(const TriangleMesh& mesh, const Patch& patch, double cell
     for (std::size_t q : next) {
       const int i = static_cast<int>(q / t.ny), j = static_cast<int>(q % t.ny);
       const double x = t.origin.x() + i * t.cell, y = t.origin.y() + j * t.cell;
-      double sum = 0;
+      double sum = 0, lo = -1e300, hi = 1e300;
       int cnt = 0;
       for (int di = -1; di <= 1; ++di)
         for (int dj = -1; dj <= 1; ++dj) {
@@ -122,9 +123,14 @@ FacetedTop faceted_top(const TriangleMesh& mesh, const Patch& patch, double cell
           const std::size_t q2 = static_cast<std::size_t>(i2) * t.ny + j2;
           if (ring[q2] < 0 || ring[q2] >= k) continue;
           sum += k == 1 ? std::clamp(plane(face[q2], x, y), h_lo, h_hi) : mz[q2];
+          const double reach = max_slope * t.cell * ((di != 0 && dj != 0) ? M_SQRT2 : 1.0);
+          lo = std::max(lo, mz[q2] - reach), hi = std::min(hi, mz[q2] + reach);
           ++cnt;
         }
-      mz[q] = sum / cnt;
+      // Past the first ring, no steeper than max_slope from any earlier neighbour (where
+      // they disagree by more, the middle of the two bounds).
+      const double h = sum / cnt;
+      mz[q] = k == 1 ? h : lo <= hi ? std::clamp(h, lo, hi) : 0.5 * (lo + hi);
     }
     front.swap(next);
   }

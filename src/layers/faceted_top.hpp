@@ -39,9 +39,11 @@ struct FacetedTop {
 /// covering the patch's XY box grown by `pad` mm. Nodes inside a patch triangle (in XY) take
 /// that triangle's height; the first ring outside continues its neighbours' triangles'
 /// planes, within [h_lo, h_hi]; each later ring takes the mean of its 8 neighbours from
-/// earlier rings, and 20 Gauss–Seidel sweeps then smooth the ridges where rings from
-/// different stretches of the rim meet (H levels off away from the rim).
-FacetedTop faceted_top(const TriangleMesh& mesh, const Patch& patch, double cell, double pad);
+/// earlier rings, never rising or falling (past the first ring) faster than `max_slope` (dz per mm,
+/// along the raster's axes and diagonals) from any of them; 20 Gauss–Seidel sweeps then smooth the
+/// ridges where rings from different stretches of the rim meet (H levels off away from the rim).
+FacetedTop faceted_top(const TriangleMesh& mesh, const Patch& patch, double cell, double pad,
+                       double max_slope);
 
 /// The facets' heights and slopes at points (x, y), without a raster: for each point with
 /// want[k], the highest patch triangle containing it in XY, or else the nearest one (by

@@ -372,7 +372,12 @@ StackResult build_stack(const TriangleMesh& mesh, const Patch& patch, int patch_
       rasterize_patch(mesh, patch, std::max(0.25, p.grid_step / 2), blend + 2.0);
   set_blend(b, wide, blend);
   // β reaches two of its cells past its raster.
-  if (p.faceted_top) b.facets = faceted_top(mesh, patch, 0.1, blend + 2.0 + 3 * wide.cell);
+  // Off the patch the top may bend no steeper than 0.8 max_angle along the raster's axes,
+  // so its bilinear interpolation (whose gradient can be √2 times that) stays printable:
+  // on the bunny a single-facet patch's continuation made a 31° path 1 mm past its corner.
+  if (p.faceted_top)
+    b.facets = faceted_top(mesh, patch, 0.1, blend + 2.0 + 3 * wide.cell,
+                           std::tan(0.8 * p.max_angle_deg * kDeg) / M_SQRT2);
   return out;
 }
 

@@ -27,7 +27,7 @@ TEST(FacetedTop, LiesOnTheFacetsAndStaysInTheirRangePastTheRim) {
   const Cap cap;
   const Patch& patch = cap.patch();
   ASSERT_TRUE(patch.needs_nonplanar());
-  const layers::FacetedTop ft = layers::faceted_top(cap.mesh, patch, 0.1, 3.0);
+  const layers::FacetedTop ft = layers::faceted_top(cap.mesh, patch, 0.1, 3.0, 0.3);
   ASSERT_FALSE(ft.empty());
   const ColumnCaster cols(cap.mesh);
   // At the raster's nodes well inside the cap (its rim is about 8.7 mm from the axis): the
