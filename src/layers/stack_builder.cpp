@@ -3,9 +3,12 @@
 #include <ceres/gradient_problem.h>
 #include <ceres/gradient_problem_solver.h>
 
+#include <tbb/task_group.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <utility>
 
 #include "layers/printability_cost.hpp"
 
@@ -19,6 +22,21 @@ std::string fmt2(const char* f, double a, double b) {
   std::snprintf(buf, sizeof buf, f, a, b);
   return buf;
 }
+
+// A task run beside the caller, waited for on every way out (tbb::task_group must be waited
+// for before it is destroyed).
+class Background {
+ public:
+  ~Background() { group_.wait(); }
+  template <class F>
+  void run(F&& f) {
+    group_.run(std::forward<F>(f));
+  }
+  void wait() { group_.wait(); }
+
+ private:
+  tbb::task_group group_;
+};
 
 class StackObjective final : public ceres::FirstOrderFunction {
  public:
@@ -271,6 +289,28 @@ StackResult build_stack(const TriangleMesh& mesh, const Patch& patch, int patch_
     }
   }
 
+  // How far the curved layers sit from the planar ones decides how gently they blend. The
+  // blend's raster and the band's faceted top depend only on that, so they are built while
+  // the optimiser runs (on FoilCutter each takes about as long as a tenth of the slice).
+  double dev = 0;
+  for (int kk = 0; kk < n; ++kk)
+    if (grid.on_patch[kk]) dev = std::max(dev, std::abs(top_z[kk] - (st.c + N * p.layer_height)));
+  const double fade = std::max(1.0, 4.5 * dev);
+  const double blend = std::max(2.0, 1.3 * 1.5 * dev / std::tan(p.max_angle_deg * kDeg));
+  PatchRaster wide;
+  FacetedTop band_facets;
+  Background background;
+  background.run([&] {
+    wide = rasterize_patch(mesh, patch, std::max(0.25, p.grid_step / 2), blend + 2.0);
+    // β reaches two of its cells past its raster. Off the patch the top may bend no steeper
+    // than 0.8 max_angle along the raster's axes, so its bilinear interpolation (whose
+    // gradient can be √2 times that) stays printable: on the bunny a single-facet patch's
+    // continuation made a 31° path 1 mm past its corner.
+    if (p.faceted_top)
+      band_facets = faceted_top(mesh, patch, 0.1, blend + 2.0 + 3 * wide.cell,
+                                std::tan(0.8 * p.max_angle_deg * kDeg) / M_SQRT2);
+  });
+
   // Starting stack and optimisation of the intermediate control heights.
   const int nc = top.surface.n_u * top.surface.n_v;
   Eigen::MatrixXd Z(N + 1, nc);
@@ -362,22 +402,10 @@ StackResult build_stack(const TriangleMesh& mesh, const Patch& patch, int patch_
   // The top's range over the patch bounds it elsewhere (see Band::top_lo); a hair of slack
   // so points between grid samples on the patch are never touched.
   b.top_lo = zmin - 0.01, b.top_hi = zmax + 0.01;
-  // How far the curved layers sit from the planar ones decides how gently they blend.
-  double dev = 0;
-  for (int kk = 0; kk < n; ++kk)
-    if (grid.on_patch[kk]) dev = std::max(dev, std::abs(top_z[kk] - (st.c + N * p.layer_height)));
-  b.fade = std::max(1.0, 4.5 * dev);
-  const double blend = std::max(2.0, 1.3 * 1.5 * dev / std::tan(p.max_angle_deg * kDeg));
-  const PatchRaster wide =
-      rasterize_patch(mesh, patch, std::max(0.25, p.grid_step / 2), blend + 2.0);
+  b.fade = fade;
+  background.wait();
   set_blend(b, wide, blend);
-  // β reaches two of its cells past its raster.
-  // Off the patch the top may bend no steeper than 0.8 max_angle along the raster's axes,
-  // so its bilinear interpolation (whose gradient can be √2 times that) stays printable:
-  // on the bunny a single-facet patch's continuation made a 31° path 1 mm past its corner.
-  if (p.faceted_top)
-    b.facets = faceted_top(mesh, patch, 0.1, blend + 2.0 + 3 * wide.cell,
-                           std::tan(0.8 * p.max_angle_deg * kDeg) / M_SQRT2);
+  b.facets = std::move(band_facets);
   return out;
 }
 
