@@ -5,32 +5,33 @@
 #include <limits>
 
 namespace nonplanar::layers {
+namespace {
+
+// The raster cell around (x, y): its first node and the fractions (u, v) across it. H is
+// constant past the raster's edge.
+struct Cell {
+  const double* p;
+  double u, v;
+};
+Cell locate(const FacetedTop& t, double x, double y) {
+  const double fx = std::clamp((x - t.origin.x()) / t.cell, 0.0, t.nx - 1.0);
+  const double fy = std::clamp((y - t.origin.y()) / t.cell, 0.0, t.ny - 1.0);
+  const int i = std::clamp(static_cast<int>(std::floor(fx)), 0, t.nx - 2);
+  const int j = std::clamp(static_cast<int>(std::floor(fy)), 0, t.ny - 2);
+  return {&t.h[static_cast<std::size_t>(i) * t.ny + j], fx - i, fy - j};
+}
+
+}  // namespace
+
 double FacetedTop::height(double x, double y) const {
-  // Constant past the raster's edge.
-  const double fx = std::clamp((x - origin.x()) / cell, 0.0, nx - 1.0);
-  const double fy = std::clamp((y - origin.y()) / cell, 0.0, ny - 1.0);
-  int i = static_cast<int>(std::floor(fx)), j = static_cast<int>(std::floor(fy));
-  i = std::clamp(i, 0, nx - 2), j = std::clamp(j, 0, ny - 2);
-  const double u = fx - i, v = fy - j;
-  const double* p = &h[static_cast<std::size_t>(i) * ny + j];
+  const auto [p, u, v] = locate(*this, x, y);
   return (1 - u) * ((1 - v) * p[0] + v * p[1]) + u * ((1 - v) * p[ny] + v * p[ny + 1]);
 }
 
 Vec2 FacetedTop::gradient(double x, double y) const {
-  // Constant past the raster's edge.
-  const double fx = std::clamp((x - origin.x()) / cell, 0.0, nx - 1.0);
-  const double fy = std::clamp((y - origin.y()) / cell, 0.0, ny - 1.0);
-  int i = static_cast<int>(std::floor(fx)), j = static_cast<int>(std::floor(fy));
-  i = std::clamp(i, 0, nx - 2), j = std::clamp(j, 0, ny - 2);
-  const double u = fx - i, v = fy - j;
-  const double* p = &h[static_cast<std::size_t>(i) * ny + j];
+  const auto [p, u, v] = locate(*this, x, y);
   return {((1 - v) * (p[ny] - p[0]) + v * (p[ny + 1] - p[1])) / cell,
           ((1 - u) * (p[1] - p[0]) + u * (p[ny + 1] - p[ny])) / cell};
-}
-
-bool FacetedTop::covers(double x, double y) const {
-  const double fx = (x - origin.x()) / cell, fy = (y - origin.y()) / cell;
-  return fx >= 0 && fy >= 0 && fx <= nx - 1 && fy <= ny - 1;
 }
 
 FacetedTop faceted_top(const TriangleMesh& mesh, const Patch& patch, double cell, double pad,

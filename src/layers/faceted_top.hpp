@@ -27,12 +27,10 @@ struct FacetedTop {
   std::vector<double> h;      ///< nx·ny node heights H, mm (node (i, j) at index i·ny + j)
   double h_lo = 0, h_hi = 0;  ///< the patch's height range (its vertices), mm
   bool empty() const { return h.empty(); }
-  /// H at (x, y), bilinear between nodes, mm. Only meaningful inside the raster.
+  /// H at (x, y), bilinear between nodes, mm (constant past the raster's edge).
   double height(double x, double y) const;
   /// (∂H/∂x, ∂H/∂y) of the bilinear interpolant at (x, y).
   Vec2 gradient(double x, double y) const;
-  /// Whether (x, y) lies inside the raster.
-  bool covers(double x, double y) const;
 };
 
 /// H on a raster of `cell` mm (coarser for huge patches: at most about 2 million nodes)
