@@ -35,8 +35,8 @@ struct LayerParams {
   StackOptimizer optimizer = StackOptimizer::lbfgs;
   int max_iterations = 100;
   double grid_step = 0.5;  ///< quadrature and check spacing over the footprint
-  /// The stack's top lies on the patch's facets (fit + faceted residual, see
-  /// src/layers/top_residual.hpp) rather than on the smooth fit through them.
+  /// The stack's top lies on the patch's facets (src/layers/faceted_top.hpp) rather than on
+  /// the smooth fit through their vertices.
   bool faceted_top = true;
 };
 
@@ -47,7 +47,8 @@ struct LayerStack {
   int layers = 0;       ///< N
   double T_bottom = 0;  ///< layer coordinate of the plane c
   /// S_0 (top) … S_N (plane), same knots and weights. With LayerParams::faceted_top the
-  /// printed layers add (N − i)/N times the top's faceted residual to these.
+  /// printed top is the facets and the printed layers keep these surfaces' proportions
+  /// between it and the plane.
   std::vector<HeightField> surfaces;
   Vec2 xy_min{0, 0}, xy_max{0, 0};  ///< the patch's footprint
   // Figures over the patch, mm and degrees (after optimisation).

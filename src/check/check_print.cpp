@@ -145,30 +145,28 @@ bool plane_z(const PointGrid& g, int layer, double x, double y, double* z, Vec3*
   const double spread = strict ? kSpread : 0.5 * kSpread;
   if (eig.eigenvalues()[0] < spread * spread)
     return !line && close;  // a slope makes a farther point's height misleading
-  // One line and a stray point or two beside it spread enough, but tilt the plane about the
-  // line: `strict` wants at least three points off the points' main line (by 0.2 mm: the
-  // stray point also tilts the principal axis, so the line's own ends sit up to 0.1 mm off
-  // it). Thickness asks for it; the deviation keeps a tilted plane, which on a 27° slope
-  // is still nearer the layer than the nearest point's height.
+  if (strict) {
+    // Sparse infill lines cross at angles and lie 2 mm or more apart: a plane through the
+    // pieces within reach reads a sloped layer's height by their few points (0.34 mm for a
+    // 0.29 mm layer on the bunny). Measure at the nearest line instead.
+    if (2 * sparse > n) return !line && close;
+    // One line and a stray point or two beside it spread enough, but tilt the plane about
+    // the line: at least three points must lie off the points' main line (by 0.2 mm: the
+    // stray point also tilts the principal axis, so the line's own ends sit up to 0.1 mm off
+    // it). Thickness asks for this; the deviation keeps a tilted plane, which on a 27° slope
+    // is still nearer the layer than the nearest point's height.
+    const Vec2 across = eig.eigenvectors().col(0);
+    int off = 0;
+    g.near(x, y, layer, [&](const Pt& q) {
+      const double dx = q.p.x() - x, dy = q.p.y() - y;
+      if (dx * dx + dy * dy > kNear * kNear) return;
+      off += std::abs((dx - mx) * across.x() + (dy - my) * across.y()) > 2 * kSpread;
+    });
+    if (off < 3) return !line && close;
+  }
   const Eigen::Vector3d sol = A.ldlt().solve(b);
   *z = sol[0];
   if (slope) *slope = Vec2(sol[1], sol[2]);
-  if (!strict) return true;
-  // Sparse infill lines cross at angles and lie 2 mm or more apart: a plane through the
-  // pieces within reach reads a sloped layer's height by their few points (0.34 mm for a
-  // 0.29 mm layer on the bunny). Measure at the nearest line instead.
-  if (2 * sparse > n) return false;
-  const Vec2 across = eig.eigenvectors().col(0);
-  int off = 0;
-  g.near(x, y, layer, [&](const Pt& q) {
-    const double dx = q.p.x() - x, dy = q.p.y() - y;
-    if (dx * dx + dy * dy > kNear * kNear) return;
-    off += std::abs((dx - mx) * across.x() + (dy - my) * across.y()) > 2 * kSpread;
-  });
-  if (off < 3) {
-    *z = z_near;
-    return !line && close;
-  }
   return true;
 }
 

@@ -21,6 +21,50 @@ Cell locate(const FacetedTop& t, double x, double y) {
   return {&t.h[static_cast<std::size_t>(i) * t.ny + j], fx - i, fy - j};
 }
 
+// A patch triangle seen from above: which (x, y) it covers and its plane's height there.
+// l1, l2 are the barycentric coordinates of b and c; d is twice the signed XY area (0: a
+// vertical triangle, which covers nothing).
+struct Facet {
+  Vec3 a, b, c;
+  double d;
+  Facet(const TriangleMesh& m, int f)
+      : a(m.vertices[m.faces[f][0]]),
+        b(m.vertices[m.faces[f][1]]),
+        c(m.vertices[m.faces[f][2]]),
+        d((b.x() - a.x()) * (c.y() - a.y()) - (c.x() - a.x()) * (b.y() - a.y())) {}
+  double l1(double x, double y) const {
+    return ((x - a.x()) * (c.y() - a.y()) - (c.x() - a.x()) * (y - a.y())) / d;
+  }
+  double l2(double x, double y) const {
+    return ((b.x() - a.x()) * (y - a.y()) - (x - a.x()) * (b.y() - a.y())) / d;
+  }
+  bool covers(double x, double y) const {
+    if (d == 0) return false;
+    const double u = l1(x, y), v = l2(x, y);
+    return u >= -1e-9 && v >= -1e-9 && u + v <= 1 + 1e-9;
+  }
+  /// The plane's height at (x, y), inside or not (d ≠ 0).
+  double z(double x, double y) const {
+    return a.z() + l1(x, y) * (b.z() - a.z()) + l2(x, y) * (c.z() - a.z());
+  }
+  Vec2 xy_min() const { return a.head<2>().cwiseMin(b.head<2>()).cwiseMin(c.head<2>()); }
+  Vec2 xy_max() const { return a.head<2>().cwiseMax(b.head<2>()).cwiseMax(c.head<2>()); }
+  Vec2 slope() const {
+    const Vec3 n = (b - a).cross(c - a);
+    return {-n.x() / n.z(), -n.y() / n.z()};
+  }
+};
+
+// The patch's height range, from its vertices (so it does not depend on any raster).
+void height_range(const TriangleMesh& mesh, const Patch& patch, double* lo, double* hi) {
+  *lo = std::numeric_limits<double>::infinity(), *hi = -*lo;
+  for (int f : patch.faces)
+    for (int v : mesh.faces[f]) {
+      *lo = std::min(*lo, mesh.vertices[v].z());
+      *hi = std::max(*hi, mesh.vertices[v].z());
+    }
+}
+
 }  // namespace
 
 double FacetedTop::height(double x, double y) const {
@@ -49,24 +93,18 @@ FacetedTop faceted_top(const TriangleMesh& mesh, const Patch& patch, double cell
   std::vector<int> face(n, -1);  ///< the triangle that gave mz
   // The triangles' heights at the nodes inside them (the highest where two overlap in XY).
   for (int f : patch.faces) {
-    const auto& tri = mesh.faces[f];
-    const Vec3 &a = mesh.vertices[tri[0]], &b = mesh.vertices[tri[1]], &c = mesh.vertices[tri[2]];
-    const double d = (b.x() - a.x()) * (c.y() - a.y()) - (c.x() - a.x()) * (b.y() - a.y());
-    if (d == 0) continue;
-    const double x_lo = std::min({a.x(), b.x(), c.x()}), x_hi = std::max({a.x(), b.x(), c.x()});
-    const double y_lo = std::min({a.y(), b.y(), c.y()}), y_hi = std::max({a.y(), b.y(), c.y()});
-    const int i0 = std::max(0, static_cast<int>(std::ceil((x_lo - t.origin.x()) / t.cell)));
-    const int i1 = std::min(t.nx - 1, static_cast<int>(std::floor((x_hi - t.origin.x()) / t.cell)));
-    const int j0 = std::max(0, static_cast<int>(std::ceil((y_lo - t.origin.y()) / t.cell)));
-    const int j1 = std::min(t.ny - 1, static_cast<int>(std::floor((y_hi - t.origin.y()) / t.cell)));
+    const Facet t3(mesh, f);
+    if (t3.d == 0) continue;
+    const Vec2 lo = (t3.xy_min() - t.origin) / t.cell, hi = (t3.xy_max() - t.origin) / t.cell;
+    const int i0 = std::max(0, static_cast<int>(std::ceil(lo.x())));
+    const int i1 = std::min(t.nx - 1, static_cast<int>(std::floor(hi.x())));
+    const int j0 = std::max(0, static_cast<int>(std::ceil(lo.y())));
+    const int j1 = std::min(t.ny - 1, static_cast<int>(std::floor(hi.y())));
     for (int i = i0; i <= i1; ++i)
       for (int j = j0; j <= j1; ++j) {
         const double x = t.origin.x() + i * t.cell, y = t.origin.y() + j * t.cell;
-        // Barycentric coordinates of b (l1) and c (l2).
-        const double l1 = ((x - a.x()) * (c.y() - a.y()) - (c.x() - a.x()) * (y - a.y())) / d;
-        const double l2 = ((b.x() - a.x()) * (y - a.y()) - (x - a.x()) * (b.y() - a.y())) / d;
-        if (l1 < -1e-9 || l2 < -1e-9 || l1 + l2 > 1 + 1e-9) continue;
-        const double z = a.z() + l1 * (b.z() - a.z()) + l2 * (c.z() - a.z());
+        if (!t3.covers(x, y)) continue;
+        const double z = t3.z(x, y);
         const std::size_t q = static_cast<std::size_t>(i) * t.ny + j;
         if (z > mz[q]) mz[q] = z, face[q] = f;
       }
@@ -74,28 +112,14 @@ FacetedTop faceted_top(const TriangleMesh& mesh, const Patch& patch, double cell
   // H: the triangles' heights (ring 0), then carried outward ring by ring.
   std::vector<int> ring(n, -1);
   std::vector<std::size_t> front;
-  // The patch's height range, from its vertices (so it does not depend on the raster).
-  double h_lo = std::numeric_limits<double>::infinity(), h_hi = -h_lo;
-  for (int f : patch.faces)
-    for (int v : mesh.faces[f]) {
-      h_lo = std::min(h_lo, mesh.vertices[v].z());
-      h_hi = std::max(h_hi, mesh.vertices[v].z());
-    }
+  double h_lo = 0, h_hi = 0;
+  height_range(mesh, patch, &h_lo, &h_hi);
   for (std::size_t k = 0; k < n; ++k)
     if (mz[k] > lowest) {
       ring[k] = 0;
       front.push_back(k);
     }
   if (front.empty()) return {};  // no node falls inside the patch: the caller keeps the fit
-  // The plane of triangle f at (x, y), extrapolated.
-  const auto plane = [&](int f, double x, double y) {
-    const auto& tri = mesh.faces[f];
-    const Vec3 &a = mesh.vertices[tri[0]], &b = mesh.vertices[tri[1]], &c = mesh.vertices[tri[2]];
-    const double d = (b.x() - a.x()) * (c.y() - a.y()) - (c.x() - a.x()) * (b.y() - a.y());
-    const double l1 = ((x - a.x()) * (c.y() - a.y()) - (c.x() - a.x()) * (y - a.y())) / d;
-    const double l2 = ((b.x() - a.x()) * (y - a.y()) - (x - a.x()) * (b.y() - a.y())) / d;
-    return a.z() + l1 * (b.z() - a.z()) + l2 * (c.z() - a.z());
-  };
   // The first ring continues its neighbours' facets (so a raster cell that straddles the rim
   // interpolates planes no steeper than the patch's); later rings take the mean of their 8
   // neighbours from earlier rings.
@@ -123,7 +147,7 @@ FacetedTop faceted_top(const TriangleMesh& mesh, const Patch& patch, double cell
           if (i2 < 0 || j2 < 0 || i2 >= t.nx || j2 >= t.ny) continue;
           const std::size_t q2 = static_cast<std::size_t>(i2) * t.ny + j2;
           if (ring[q2] < 0 || ring[q2] >= k) continue;
-          sum += k == 1 ? std::clamp(plane(face[q2], x, y), h_lo, h_hi) : mz[q2];
+          sum += k == 1 ? std::clamp(Facet(mesh, face[q2]).z(x, y), h_lo, h_hi) : mz[q2];
           const double reach = max_slope * t.cell * ((di != 0 && dj != 0) ? M_SQRT2 : 1.0);
           lo = std::max(lo, mz[q2] - reach), hi = std::min(hi, mz[q2] + reach);
           ++cnt;
@@ -155,12 +179,7 @@ FacetSamples facet_samples(const TriangleMesh& mesh, const Patch& patch,
   const double nan = std::numeric_limits<double>::quiet_NaN();
   out.h.assign(xy.size(), nan);
   out.slope.assign(xy.size(), Vec2(nan, nan));
-  out.h_lo = std::numeric_limits<double>::infinity(), out.h_hi = -out.h_lo;
-  for (int f : patch.faces)
-    for (int v : mesh.faces[f]) {
-      out.h_lo = std::min(out.h_lo, mesh.vertices[v].z());
-      out.h_hi = std::max(out.h_hi, mesh.vertices[v].z());
-    }
+  height_range(mesh, patch, &out.h_lo, &out.h_hi);
   if (patch.faces.empty()) return out;
   // Triangles binned by their XY boxes on buckets of about four triangles' size.
   const Vec2 lo = patch.xy_min, ext = (patch.xy_max - patch.xy_min).cwiseMax(Vec2(1e-6, 1e-6));
@@ -170,12 +189,10 @@ FacetSamples facet_samples(const TriangleMesh& mesh, const Patch& patch,
   std::vector<std::vector<int>> bucket(static_cast<std::size_t>(bx) * by);
   const auto clampi = [](double v, int n) { return std::clamp(static_cast<int>(v), 0, n - 1); };
   for (int f : patch.faces) {
-    const auto& t = mesh.faces[f];
-    const Vec3 &a = mesh.vertices[t[0]], &c1 = mesh.vertices[t[1]], &c2 = mesh.vertices[t[2]];
-    const int i0 = clampi((std::min({a.x(), c1.x(), c2.x()}) - lo.x()) / b, bx);
-    const int i1 = clampi((std::max({a.x(), c1.x(), c2.x()}) - lo.x()) / b, bx);
-    const int j0 = clampi((std::min({a.y(), c1.y(), c2.y()}) - lo.y()) / b, by);
-    const int j1 = clampi((std::max({a.y(), c1.y(), c2.y()}) - lo.y()) / b, by);
+    const Facet t3(mesh, f);
+    const Vec2 f_lo = (t3.xy_min() - lo) / b, f_hi = (t3.xy_max() - lo) / b;
+    const int i0 = clampi(f_lo.x(), bx), i1 = clampi(f_hi.x(), bx);
+    const int j0 = clampi(f_lo.y(), by), j1 = clampi(f_hi.y(), by);
     for (int i = i0; i <= i1; ++i)
       for (int j = j0; j <= j1; ++j) bucket[static_cast<std::size_t>(i) * by + j].push_back(f);
   }
@@ -190,28 +207,21 @@ FacetSamples facet_samples(const TriangleMesh& mesh, const Patch& patch,
     for (int i = std::max(0, ci - 1); i <= std::min(bx - 1, ci + 1); ++i)
       for (int j = std::max(0, cj - 1); j <= std::min(by - 1, cj + 1); ++j)
         for (int f : bucket[static_cast<std::size_t>(i) * by + j]) {
-          const auto& t = mesh.faces[f];
-          const Vec3 &a = mesh.vertices[t[0]], &p1 = mesh.vertices[t[1]], &p2 = mesh.vertices[t[2]];
-          const double d =
-              (p1.x() - a.x()) * (p2.y() - a.y()) - (p2.x() - a.x()) * (p1.y() - a.y());
-          if (d == 0) continue;
-          const double l1 = ((x - a.x()) * (p2.y() - a.y()) - (p2.x() - a.x()) * (y - a.y())) / d;
-          const double l2 = ((p1.x() - a.x()) * (y - a.y()) - (x - a.x()) * (p1.y() - a.y())) / d;
-          const double z = a.z() + l1 * (p1.z() - a.z()) + l2 * (p2.z() - a.z());
-          if (l1 >= -1e-9 && l2 >= -1e-9 && l1 + l2 <= 1 + 1e-9) {
+          const Facet t3(mesh, f);
+          if (t3.d == 0) continue;
+          if (t3.covers(x, y)) {
+            const double z = t3.z(x, y);
             if (z > best) best = z, inside = f;
             continue;
           }
-          const Vec2 g = (a + p1 + p2).head<2>() / 3.0 - xy[k];
+          const Vec2 g = (t3.a + t3.b + t3.c).head<2>() / 3.0 - xy[k];
           if (g.squaredNorm() < near_d) near_d = g.squaredNorm(), nearest = f;
         }
     const int f = inside >= 0 ? inside : nearest;
     if (f < 0) continue;
-    const auto& t = mesh.faces[f];
-    const Vec3 &a = mesh.vertices[t[0]], &p1 = mesh.vertices[t[1]], &p2 = mesh.vertices[t[2]];
-    const Vec3 nrm = (p1 - a).cross(p2 - a);
-    out.slope[k] = Vec2(-nrm.x() / nrm.z(), -nrm.y() / nrm.z());
-    out.h[k] = a.z() + out.slope[k].dot(xy[k] - a.head<2>());
+    const Facet t3(mesh, f);
+    out.slope[k] = t3.slope();
+    out.h[k] = t3.a.z() + out.slope[k].dot(xy[k] - t3.a.head<2>());
   }
   return out;
 }

@@ -246,8 +246,9 @@ StackResult build_stack(const TriangleMesh& mesh, const Patch& patch, int patch_
   for (double kk = k; kk >= 0 && kk > k - 200; --kk) {
     const double c = p.first_layer_height + kk * p.layer_height;
     const int a = count_for(c, false), b = count_for(c, true);
-    if (tip_clear(c, a) || tip_clear(c, b)) {
-      k_pick = kk, N = tip_clear(c, a) ? a : b;
+    const int clear = tip_clear(c, a) ? a : tip_clear(c, b) ? b : 0;
+    if (clear > 0) {
+      k_pick = kk, N = clear;
       break;
     }
   }
