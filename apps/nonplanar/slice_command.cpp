@@ -80,11 +80,16 @@ int run(const SliceOptions& o) {
   report_warnings(o.mesh.model, *loaded, o.mesh.quiet);
   if (!o.mesh.quiet) {
     for (const auto& n : result->notices) std::fprintf(stderr, "notice: %s\n", n.c_str());
+    char curved[80];
+    if (result->shell_layers > 0)
+      std::snprintf(curved, sizeof curved, "a curved shell of %d layers", result->shell_layers);
+    else
+      std::snprintf(curved, sizeof curved, "%zu curved stack%s", result->plan.stacks.size(),
+                    result->plan.stacks.size() == 1 ? "" : "s");
     std::fprintf(stderr,
-                 "wrote %s: %zu layers, %zu curved stack%s, layer thickness %.3f-%.3f mm, "
+                 "wrote %s: %zu layers, %s, layer thickness %.3f-%.3f mm, "
                  "steepest extrusion %.1f deg, 0 collisions\n",
-                 o.output.c_str(), result->layers.size(), result->plan.stacks.size(),
-                 result->plan.stacks.size() == 1 ? "" : "s", result->thickness_min,
+                 o.output.c_str(), result->layers.size(), curved, result->thickness_min,
                  result->thickness_max, result->steepest_deg);
   }
   return kExitOk;

@@ -29,6 +29,7 @@ struct SliceResult {
   double thickness_min = 0, thickness_max = 0, steepest_deg = 0;
   std::size_t collisions = 0;
   bool nonplanar = false;
+  int shell_layers = 0;  ///< curved layers of a shell over a planar core (0: none)
 };
 
 /// Runs the pipeline on a mesh already placed on the bed. A violation of the printer limits

@@ -28,6 +28,12 @@ struct SlicedLayer {
 Expected<std::vector<SlicedLayer>> slice_mesh(const TriangleMesh& mesh, const SliceParams& params,
                                               const Context& ctx);
 
+/// The same cut at the given layers' z_slice (their spans are kept; islands replaced), for a
+/// caller that chooses its own layer heights.
+Expected<std::vector<SlicedLayer>> slice_mesh_at(const TriangleMesh& mesh,
+                                                 std::vector<SlicedLayer> layers,
+                                                 const Context& ctx);
+
 /// Area of polygons with holes, mm².
 double area(const std::vector<ExPolygon>& polys);
 

@@ -3,9 +3,11 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <optional>
 
 #include "deform/gate_zones.hpp"
+#include "deform/shell_toolpaths.hpp"
 #include "layers/banded_field.hpp"
 #include "nonplanar/deform.hpp"
 #include "nonplanar/pipeline.hpp"
@@ -31,6 +33,73 @@ SliceJob make_job(const PrintConfig& print, double max_angle_deg) {
 }
 
 namespace {
+
+// Safety (DESIGN.md §3) on r.layers, rounded first to the µm they are written with (so
+// `check` on the file agrees with this gate even for a point at the collision depth's edge):
+// thickness and slope from the paths themselves, collisions with earlier layers from the
+// independent check, looked for only near a band's curved layers when `banded` is given
+// (gate_zones.hpp), everywhere else. Every breach goes to `violation`; false when it said stop.
+// Fills r's figures.
+using Violation = std::function<bool(const Vec3&, const char*)>;
+Expected<bool> gate(SliceResult& r, const SliceJob& job, const layers::BandedField* banded,
+                    const Violation& violation, const Context& ctx) {
+  for (LayerToolpaths& layer : r.layers)
+    for (ExtrusionPath& p : layer.paths)
+      for (Vec3& v : p.points) v = (v * 1000.0).array().round() / 1000.0;
+  const LayerParams& L = job.layers;
+  r.thickness_min = 1e300, r.thickness_max = 0;
+  const double tan_max = std::tan((L.max_angle_deg + 0.5) * M_PI / 180.0);
+  for (std::size_t li = 0; li < r.layers.size(); ++li)
+    for (const ExtrusionPath& p : r.layers[li].paths) {
+      if (p.role == ExtrusionRole::skirt) continue;
+      for (std::size_t k = 0; k < p.points.size(); ++k) {
+        if (li > 0) {
+          r.thickness_min = std::min(r.thickness_min, p.height[k]);
+          r.thickness_max = std::max(r.thickness_max, p.height[k]);
+          if ((p.height[k] < L.min_layer_height - 1e-3 ||
+               p.height[k] > L.max_layer_height + 1e-3) &&
+              !violation(p.points[k], "a layer leaves the thickness limits"))
+            return false;
+        }
+        if (k == 0) continue;
+        const double dxy = (p.points[k] - p.points[k - 1]).head<2>().norm();
+        const double dz = std::abs(p.points[k].z() - p.points[k - 1].z());
+        if (dxy > 0.05) r.steepest_deg = std::max(r.steepest_deg, std::atan2(dz, dxy) * 180 / M_PI);
+        if (dxy > 0.05 && dz > tan_max * dxy &&
+            !violation(p.points[k], "an extrusion is steeper than max_angle"))
+          return false;
+      }
+    }
+  if (r.thickness_min > r.thickness_max) r.thickness_min = r.thickness_max = 0;
+  if (!r.nonplanar) return true;  // planar layers cannot dig into earlier ones
+  // Collisions are looked for even when bands already broke a limit, so one retry drops
+  // every offender (each retry replans, reslices and rechecks the whole part).
+  CheckParams cp;
+  cp.max_angle_deg = L.max_angle_deg;
+  cp.layer_height = L.layer_height;
+  cp.nozzle_tip_radius = L.nozzle_tip_radius;
+  cp.nozzle_angle_deg = L.nozzle_angle_deg;
+  cp.block_radius = L.block_radius;
+  cp.block_clearance = L.block_clearance;
+  cp.filament_diameter = job.print.gcode.filament_diameter;
+  cp.collisions_only = true;
+  // Only where a curved layer is within the heater block's reach (gate_zones.hpp): on the
+  // bunny that skipped most of 24 million extrusion samples.
+  GateZones zones = banded ? gate_zones(*banded, cp.block_radius) : GateZones{};
+  zones.find_last_layers(r.layers);
+  cp.collision_zones = zones.query;
+  auto figures = check_print(moves_from_toolpaths(r.layers, job.print.gcode,
+                                                  [&](const ExtrusionPath& p, int li) {
+                                                    return !banded || zones.may_matter(p, li);
+                                                  }),
+                             nullptr, cp, ctx);
+  if (!figures) return figures.error();
+  r.collisions = figures->collisions;
+  if (figures->collisions > 0)
+    for (const Vec3& p : figures->collision_points)
+      if (!violation(p, "an extrusion would hit earlier layers")) return false;
+  return true;
+}
 
 // One attempt with the patches not in `excluded`. On a limit violation inside a curved band,
 // every such band's patch and what it broke are added to *offenders (the caller retries
@@ -119,16 +188,6 @@ Expected<SliceResult> attempt(const TriangleMesh& mesh, const SliceJob& job, con
     r.layers = std::move(*mapped);
   }
 
-  // The G-code holds coordinates to 1 µm: check exactly what will be written, so `check`
-  // on the file agrees with this gate even for a point at the collision depth's edge.
-  for (LayerToolpaths& L : r.layers)
-    for (ExtrusionPath& p : L.paths)
-      for (Vec3& v : p.points) v = (v * 1000.0).array().round() / 1000.0;
-
-  // Safety (DESIGN.md §3): thickness and slope from the paths themselves, collisions with
-  // earlier layers from the independent check.
-  const LayerParams& L = job.layers;
-  // The band a location belongs to: the stack whose footprint (grown by a blend) holds it.
   // The band a location belongs to: the one whose blend weight β is largest there (the
   // stacks and the field's bands are in the same order).
   const auto* banded = dynamic_cast<const layers::BandedField*>(r.plan.field.get());
@@ -158,58 +217,74 @@ Expected<SliceResult> attempt(const TriangleMesh& mesh, const SliceJob& job, con
     offenders->emplace_back(band, buf);
     return true;
   };
-  r.thickness_min = 1e300, r.thickness_max = 0;
-  const double tan_max = std::tan((L.max_angle_deg + 0.5) * M_PI / 180.0);
-  for (std::size_t li = 0; li < r.layers.size(); ++li)
-    for (const ExtrusionPath& p : r.layers[li].paths) {
-      if (p.role == ExtrusionRole::skirt) continue;
-      for (std::size_t k = 0; k < p.points.size(); ++k) {
-        if (li > 0) {
-          r.thickness_min = std::min(r.thickness_min, p.height[k]);
-          r.thickness_max = std::max(r.thickness_max, p.height[k]);
-          if ((p.height[k] < L.min_layer_height - 1e-3 ||
-               p.height[k] > L.max_layer_height + 1e-3) &&
-              !violation(p.points[k], "a layer leaves the thickness limits"))
-            return *fatal;
-        }
-        if (k == 0) continue;
-        const double dxy = (p.points[k] - p.points[k - 1]).head<2>().norm();
-        const double dz = std::abs(p.points[k].z() - p.points[k - 1].z());
-        if (dxy > 0.05) r.steepest_deg = std::max(r.steepest_deg, std::atan2(dz, dxy) * 180 / M_PI);
-        if (dxy > 0.05 && dz > tan_max * dxy &&
-            !violation(p.points[k], "an extrusion is steeper than max_angle"))
-          return *fatal;
-      }
-    }
-  if (r.thickness_min > r.thickness_max) r.thickness_min = r.thickness_max = 0;
-  if (!r.nonplanar) return r;  // planar layers cannot dig into earlier ones
-  // Collisions are looked for even when bands already broke a limit, so one retry drops
-  // every offender (each retry replans, reslices and rechecks the whole part).
-  CheckParams cp;
-  cp.max_angle_deg = L.max_angle_deg;
-  cp.layer_height = L.layer_height;
-  cp.nozzle_tip_radius = L.nozzle_tip_radius;
-  cp.nozzle_angle_deg = L.nozzle_angle_deg;
-  cp.block_radius = L.block_radius;
-  cp.block_clearance = L.block_clearance;
-  cp.filament_diameter = job.print.gcode.filament_diameter;
-  cp.collisions_only = true;
-  // Only where a curved layer is within the heater block's reach (gate_zones.hpp): on the
-  // bunny that skipped most of 24 million extrusion samples.
-  GateZones zones = banded ? gate_zones(*banded, cp.block_radius) : GateZones{};
-  zones.find_last_layers(r.layers);
-  cp.collision_zones = zones.query;
-  auto figures = check_print(moves_from_toolpaths(r.layers, job.print.gcode,
-                                                  [&](const ExtrusionPath& p, int li) {
-                                                    return !banded || zones.may_matter(p, li);
-                                                  }),
-                             nullptr, cp, ctx);
-  if (!figures) return figures.error();
-  r.collisions = figures->collisions;
-  if (figures->collisions > 0)
-    for (const Vec3& p : figures->collision_points)
-      if (!violation(p, "an extrusion would hit earlier layers")) return *fatal;
+  auto ok = gate(r, job, banded, violation, ctx);
+  if (!ok) return ok.error();
+  if (!*ok) return *fatal;
   return r;
+}
+
+// A part whose whole top is one patch no stack over a plane could follow (the result of the
+// attempts is planar): curved shell layers over a planar core (layers/shell_plan.hpp) if the
+// gate passes them. Empty when the part is not of that kind or the shell breaks a limit (a
+// notice then says why).
+Expected<std::optional<SliceResult>> try_shell(const TriangleMesh& mesh, const SliceJob& job,
+                                               const Analysis& analysis, SliceResult& planar,
+                                               const Context& ctx) {
+  // All the patches that need curved layers, taken as one top (the CurviSlicer airfoil's top
+  // is two, split at a crease); failing that, the largest alone.
+  std::vector<int> all;
+  for (std::size_t i = 0; i < analysis.patches.size(); ++i)
+    if (analysis.patches[i].needs_nonplanar()) all.push_back(static_cast<int>(i));
+  if (all.empty()) return std::optional<SliceResult>{};
+  layers::ShellPlan plan = layers::plan_shell(mesh, analysis, all, job.layers);
+  if (!plan.refused.empty() && all.size() > 1) {
+    layers::ShellPlan one = layers::plan_shell(mesh, analysis, {all.front()}, job.layers);
+    if (one.refused.empty()) plan = std::move(one);
+  }
+  std::string name = "patch";
+  if (plan.patches.size() > 1) name += "es";
+  for (std::size_t k = 0; k < plan.patches.size(); ++k)
+    name += (k ? ", " : " ") + std::to_string(plan.patches[k]);
+  if (!plan.refused.empty()) {
+    if (plan.refused != layers::kNotOnTop)
+      planar.notices.push_back(name + " not printed as a shell: " + plan.refused);
+    return std::optional<SliceResult>{};
+  }
+  auto paths = shell_toolpaths(mesh, plan, job.print, ctx);
+  if (!paths) return paths.error();
+  SliceResult r;
+  r.header = planar.header;
+  char buf[200];
+  std::snprintf(buf, sizeof buf,
+                "%s: a shell of %d curved layers of %.2f mm over %zu planar core layers",
+                name.c_str(), plan.N, plan.t, plan.core.size() - 1);
+  r.header.push_back(buf);
+  for (const std::string& n : planar.notices) {
+    const bool about_shell = std::any_of(plan.patches.begin(), plan.patches.end(), [&](int i) {
+      return n.rfind("patch " + std::to_string(i) + " ", 0) == 0;
+    });
+    if (!about_shell && n.rfind("no patch can", 0) != 0) r.notices.push_back(n);
+  }
+  r.notices.push_back(name + ": curved shell over a planar core (no stack over a plane fits it)");
+  r.layers = std::move(*paths);
+  r.nonplanar = true;
+  r.shell_layers = plan.N;
+  std::string breach;
+  auto ok = gate(
+      r, job, nullptr,
+      [&](const Vec3& p, const char* what) {
+        char b[200];
+        std::snprintf(b, sizeof b, "%s at (%.2f, %.2f, %.2f)", what, p.x(), p.y(), p.z());
+        breach = b;
+        return false;
+      },
+      ctx);
+  if (!ok) return ok.error();
+  if (!*ok) {
+    planar.notices.push_back(name + " not printed as a shell: " + breach);
+    return std::optional<SliceResult>{};
+  }
+  return std::optional<SliceResult>(std::move(r));
 }
 
 }  // namespace
@@ -233,6 +308,11 @@ Expected<SliceResult> slice_model(const TriangleMesh& mesh, const SliceJob& job,
     if (!r) return r;
     if (offenders.empty()) {
       r->notices.insert(r->notices.begin(), dropped.begin(), dropped.end());
+      if (!job.planar_only && !r->nonplanar) {
+        auto shell = try_shell(mesh, job, pre.analysis, *r, ctx);
+        if (!shell) return shell.error();
+        if (*shell) return std::move(**shell);
+      }
       return r;
     }
     // A stack that met every limit on its own grid broke one in the final paths: print

@@ -153,6 +153,12 @@ Expected<std::vector<SlicedLayer>> slice_mesh(const TriangleMesh& mesh, const Sl
       return Error{Status::invalid_argument,
                    "slice: more than 200000 layers (layer_height too small?)"};
   }
+  return slice_mesh_at(mesh, std::move(layers), ctx);
+}
+
+Expected<std::vector<SlicedLayer>> slice_mesh_at(const TriangleMesh& mesh,
+                                                 std::vector<SlicedLayer> layers,
+                                                 const Context& ctx) {
   // Faces sorted by their lowest z; a layer only looks at faces that can reach it.
   const std::size_t nf = mesh.faces.size();
   std::vector<int> order(nf);

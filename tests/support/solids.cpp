@@ -139,4 +139,9 @@ TriangleMesh dome_cut_by_box() {
       -a, a, -a, a, 72, 72);
 }
 
+TriangleMesh rib() {
+  return height_field_solid([](double x, double) { return 0.3 + 12 * std::sin(M_PI * x / 100); }, 0,
+                            80, 0, 12, 160, 12);
+}
+
 }  // namespace nonplanar::test

@@ -39,6 +39,10 @@ TriangleMesh domed_towers();
 /// dome cut by a box: the top of a sphere of radius 40 over a 24 × 24 mm square, 6 mm high
 /// at the corners.
 TriangleMesh dome_cut_by_box();
+/// rib: a wing rib 80 × 12 mm whose top rises from 0.3 mm at its nose (x = 0) to 12.3 mm
+/// and falls to 7.35 mm at its tail, 0.3 + 12 sin(πx / 100) (at most 20.7° steep). No stack
+/// over a plane can follow it: its layer count would have to change 40-fold along it.
+TriangleMesh rib();
 
 /// The shared test models folder (../shared/models beside the repo); empty if absent.
 std::filesystem::path shared_models();

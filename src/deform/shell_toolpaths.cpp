@@ -1,0 +1,82 @@
+#include "deform/shell_toolpaths.hpp"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+
+#include "layers/height_contour.hpp"
+#include "nonplanar/deform.hpp"
+#include "slice/polygon_ops.hpp"
+
+namespace nonplanar {
+
+Expected<std::vector<LayerToolpaths>> shell_toolpaths(const TriangleMesh& mesh,
+                                                      const layers::ShellPlan& plan,
+                                                      const PrintConfig& print,
+                                                      const Context& ctx) {
+  // The core: planar layers at the plan's boundaries, layer k kept where z_k <= B + a, i.e.
+  // where H >= z_k − a + N·t.
+  std::vector<SlicedLayer> spans;
+  for (std::size_t k = 1; k < plan.core.size(); ++k) {
+    SlicedLayer l;
+    l.z_bottom = plan.core[k - 1], l.z_top = plan.core[k];
+    l.z_slice = 0.5 * (l.z_bottom + l.z_top);
+    spans.push_back(l);
+  }
+  auto core = slice_mesh_at(mesh, std::move(spans), ctx);
+  if (!core) return core.error();
+  const auto [lo_it, hi_it] = std::minmax_element(plan.top.h.begin(), plan.top.h.end());
+  const double h_lo = *lo_it, h_hi = *hi_it;
+  tbb::parallel_for(std::size_t{0}, core->size(), [&](std::size_t k) {
+    SlicedLayer& L = (*core)[k];
+    const double level = L.z_top - plan.reach + plan.N * plan.t;
+    if (level <= h_lo || L.islands.empty()) return;
+    L.islands = level > h_hi
+                    ? std::vector<ExPolygon>{}
+                    : clip::intersection_ex(L.islands, layers::region_at_least(plan.top, level));
+  });
+  while (!core->empty() && core->back().islands.empty()) core->pop_back();
+  ctx.progress("core", 1.0);
+  std::vector<LayerToolpaths> out;
+  if (!core->empty()) {
+    auto paths = make_toolpaths(*core, print.paths, ctx);
+    if (!paths) return paths.error();
+    out = std::move(*paths);
+  }
+
+  // The shell: normalised so its layers are the planes ζ = j·t … (j + 1)·t. An empty layer
+  // first stands for the bed-side neighbour make_toolpaths treats specially (first-layer
+  // width and speed, the skirt): the shell is never the first layer printed.
+  const layers::ShellField field(plan);
+  auto normalized = normalize_mesh(mesh, field, {}, ctx);
+  if (!normalized) return normalized.error();
+  std::vector<SlicedLayer> shell(static_cast<std::size_t>(plan.N) + 1);
+  for (int j = -1; j < plan.N; ++j) {
+    SlicedLayer& l = shell[static_cast<std::size_t>(j + 1)];
+    l.z_bottom = j * plan.t, l.z_top = (j + 1) * plan.t;
+    l.z_slice = (j + 0.5) * plan.t;
+  }
+  auto cut = slice_mesh_at(normalized->mesh, std::move(shell), ctx);
+  if (!cut) return cut.error();
+  (*cut)[0].islands.clear();
+  ToolpathParams tp = print.paths;
+  tp.skirts = 0;
+  auto planar = make_toolpaths(*cut, tp, ctx);
+  if (!planar) return planar.error();
+  planar->erase(planar->begin());
+  auto mapped = map_toolpaths_back(*planar, field, {}, ctx);
+  if (!mapped) return mapped.error();
+  for (std::size_t j = 0; j < mapped->size(); ++j) {
+    LayerToolpaths& L = (*mapped)[j];
+    if (L.paths.empty()) continue;
+    for (ExtrusionPath& p : L.paths)
+      for (std::size_t k = 0; k < p.points.size(); ++k)
+        p.height[k] = plan.thickness(static_cast<int>(j), p.points[k].x(), p.points[k].y());
+    L.z = L.max_z;
+    L.height = plan.t;
+    out.push_back(std::move(L));
+  }
+  return out;
+}
+
+}  // namespace nonplanar

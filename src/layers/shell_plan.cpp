@@ -1,0 +1,149 @@
+// Notation as in shell_plan.hpp.
+#include "layers/shell_plan.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+namespace nonplanar::layers {
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+constexpr double kMargin = 0.01;  ///< m: the stairs' thickness stays this far inside the limits
+
+std::string at(const char* what, const Vec3& p) {
+  char buf[200];
+  std::snprintf(buf, sizeof buf, "%s at (%.2f, %.2f, %.2f)", what, p.x(), p.y(), p.z());
+  return buf;
+}
+
+// z_1 … up to `end`: steps of at most h_c, landing on each target that can be reached in
+// steps no thinner than h_min.
+std::vector<double> core_boundaries(double h1, double h_c, double h_min, double end,
+                                    std::vector<double> targets) {
+  std::vector<double> z{0.0, h1};
+  std::sort(targets.begin(), targets.end());
+  double cur = h1;
+  for (double target : targets) {
+    if (target > end) break;
+    const double gap = target - cur;
+    if (gap < h_min - 1e-9) continue;
+    const int n = static_cast<int>(std::ceil(gap / h_c - 1e-9));
+    if (gap / n < h_min - 1e-9) continue;
+    for (int k = 1; k <= n; ++k) z.push_back(cur + gap * k / n);
+    z.back() = cur = target;
+  }
+  while (cur < end - 1e-9) z.push_back(cur += h_c);
+  return z;
+}
+
+}  // namespace
+
+double ShellPlan::core_top(double x, double y) const {
+  const double level = bottom(x, y) + reach;
+  const auto it = std::upper_bound(core.begin(), core.end(), level);
+  return it == core.begin() ? 0.0 : *(it - 1);
+}
+
+double ShellPlan::thickness(int j, double x, double y) const {
+  const double u = layer_top(j, x, y);
+  const double below = j == 0 ? core_top(x, y) : u - t;
+  return u - std::max(below, 0.0);
+}
+
+const char* const kNotOnTop = "the part's highest point is not on the patches";
+
+ShellPlan plan_shell(const TriangleMesh& mesh, const Analysis& a, const std::vector<int>& patches,
+                     const LayerParams& p) {
+  ShellPlan s;
+  s.patches = patches;
+  // The patches as one: their facets, box and height range.
+  Patch P;
+  P.xy_min = Vec2::Constant(1e300), P.xy_max = Vec2::Constant(-1e300);
+  P.z_min = 1e300, P.z_max = -1e300;
+  for (int i : patches) {
+    const Patch& q = a.patches[static_cast<std::size_t>(i)];
+    P.faces.insert(P.faces.end(), q.faces.begin(), q.faces.end());
+    P.area += q.area;
+    P.xy_min = P.xy_min.cwiseMin(q.xy_min), P.xy_max = P.xy_max.cwiseMax(q.xy_max);
+    P.z_min = std::min(P.z_min, q.z_min), P.z_max = std::max(P.z_max, q.z_max);
+  }
+  if (P.faces.empty()) {
+    s.refused = "no patch to follow";
+    return s;
+  }
+  const BoundingBox box = bounding_box(mesh);
+  if (P.z_max < box.max.z() - 0.05) {
+    s.refused = kNotOnTop;
+    return s;
+  }
+  s.t = p.layer_height;
+  const double h_c =
+      std::min(p.layer_height, p.max_layer_height - p.min_layer_height - 2 * kMargin);
+  if (h_c < p.min_layer_height || s.t < p.min_layer_height || s.t > p.max_layer_height) {
+    s.refused = "the layer limits leave no room for the core's stairs under a shell";
+    return s;
+  }
+  s.reach = s.t - p.min_layer_height - kMargin;
+  // A shell as thick as about four layers: solid under the top, and no deeper than needed
+  // (features below it keep planar layers).
+  s.N = std::max(3, static_cast<int>(std::ceil(0.8 / s.t - 1e-9)));
+  const Vec2 lo = box.min.head<2>(), hi = box.max.head<2>();
+  const double pad = std::max({P.xy_min.x() - lo.x(), P.xy_min.y() - lo.y(), hi.x() - P.xy_max.x(),
+                               hi.y() - P.xy_max.y(), 0.0}) +
+                     1.0;
+  s.top = faceted_top(mesh, P, 0.1, pad, std::tan(0.8 * p.max_angle_deg * kDeg) / M_SQRT2);
+
+  // The patch must be the part's whole top: nothing of the mesh above H (its vertices, and
+  // its edges every 0.5 mm), no overhang and no other printable up-facing surface within half
+  // a millimetre under the shell.
+  std::vector<char> in_patch(mesh.faces.size(), 0);
+  for (int f : P.faces) in_patch[static_cast<std::size_t>(f)] = 1;
+  const double cos_max = std::cos(p.max_angle_deg * kDeg);
+  for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
+    const auto& F = mesh.faces[f];
+    const Vec3 v[3] = {mesh.vertices[F[0]], mesh.vertices[F[1]], mesh.vertices[F[2]]};
+    for (int k = 0; k < 3; ++k) {
+      const Vec3 &A = v[k], &B = v[(k + 1) % 3];
+      const int n = 1 + static_cast<int>((B - A).head<2>().norm() / 0.5);
+      for (int i = 0; i < n; ++i) {
+        const Vec3 q = A + (B - A) * (static_cast<double>(i) / n);
+        if (q.z() > s.top.height(q.x(), q.y()) + 0.02) {
+          s.refused = at("the part stands above the patch", q);
+          return s;
+        }
+      }
+    }
+    if (in_patch[f]) continue;
+    const Vec3 nrm = (v[1] - v[0]).cross(v[2] - v[0]);
+    const double len = nrm.norm();
+    if (!(len > 0)) continue;
+    const double nz = nrm.z() / len;
+    const bool on_bed = std::max({v[0].z(), v[1].z(), v[2].z()}) < 1e-6;
+    const bool overhang = nz < -0.1 && !on_bed;
+    const bool printable_top = nz > cos_max;
+    if (!overhang && !printable_top) continue;
+    const Vec3 c = (v[0] + v[1] + v[2]) / 3.0;
+    for (const Vec3& q : {v[0], v[1], v[2], c})
+      if (q.z() > s.bottom(q.x(), q.y()) - 0.5) {
+        s.refused = at(overhang ? "an overhang lies under the shell"
+                                : "another printable surface lies under the shell",
+                       q);
+        return s;
+      }
+  }
+
+  // The core: up to the highest B + a, landing on the flat patches' heights.
+  double end = 0;
+  for (double h : s.top.h) end = std::max(end, h - s.N * s.t + s.reach);
+  end = std::min(end, box.max.z());
+  std::vector<double> targets;
+  for (const Patch& q : a.patches)
+    if (q.verdict == PatchVerdict::flat && q.z_max - q.z_min < 0.05)
+      targets.push_back(0.5 * (q.z_min + q.z_max));  // the wing's tilted floor: 3.55–3.58 mm
+  s.core =
+      core_boundaries(std::min(p.first_layer_height, h_c), h_c, p.min_layer_height, end, targets);
+  return s;
+}
+
+}  // namespace nonplanar::layers

@@ -1,0 +1,79 @@
+// A curved shell over a planar core: the layout for a part whose whole top is one patch that
+// a stack over a plane cannot follow (DESIGN.md §2 step 4, its fallback).
+//
+// Notation: H(x, y) the patch's faceted top, carried over the part's whole footprint
+// (faceted_top.hpp); N shell layers of thickness t, layer j (0 = lowest) spanning
+// U_j − t … U_j with U_j = H − (N − 1 − j)·t; B = H − N·t the shell's bottom; z_0 = 0 < z_1 < …
+// the planar core's layer boundaries; a the reach: core layer k (z_{k−1} … z_k) is printed
+// only where z_k <= B + a, so the core's top under (x, y) is Z_c = max{z_k <= B + a}.
+//
+// Why: a stack between a plane and the top keeps one layer count under the whole patch, so a
+// top that runs from the bed to 17.5 mm (the CurviSlicer wing) needs layers 17.5/N thick at
+// one end and nothing at the other. Here the layer count under the top varies: the planar
+// core ends in stairs under B, and the shell's lowest layer fills the stairs, so its
+// thickness U_0 − Z_c lies in [t − a, t − a + h_k) for the core's layer height h_k there;
+// a = t − h_min − m and h_k <= h_max − h_min − 2m keep it inside [h_min + m, h_max − m].
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "layers/faceted_top.hpp"
+#include "nonplanar/layers.hpp"
+
+namespace nonplanar::layers {
+
+struct ShellPlan {
+  std::vector<int> patches;  ///< the patches whose facets make the top
+  FacetedTop top;            ///< H over the part's footprint
+  int N = 0;
+  double t = 0.2;
+  double reach = 0;          ///< a, mm
+  std::vector<double> core;  ///< z_0 = 0 … z_K, the core's layer boundaries, mm
+  std::string refused;       ///< why the part cannot be printed this way (empty: it can)
+
+  double bottom(double x, double y) const { return top.height(x, y) - N * t; }
+  /// U_j(x, y).
+  double layer_top(int j, double x, double y) const { return top.height(x, y) - (N - 1 - j) * t; }
+  /// Z_c(x, y): the top of the highest core layer printed under (x, y); 0 (the bed) if none.
+  double core_top(double x, double y) const;
+  /// The thickness of shell layer j under (x, y): U_j minus the core's top (j = 0) or U_{j−1},
+  /// never below the bed.
+  double thickness(int j, double x, double y) const;
+};
+
+/// `refused` when the part's highest point is not on the patches (the usual case: a part with
+/// a curved top somewhere on it, not all over it).
+extern const char* const kNotOnTop;
+
+/// Inputs: the placed mesh, its analysis, the patches to follow together (indices into
+/// a.patches) and the printer limits. Output: a plan, or one with `refused` set when they are not
+/// the part's whole top (some of the mesh stands above H), another printable up-facing surface or
+/// an overhang lies inside the shell, or the limits leave no room for the stairs. The core's
+/// boundaries land on every flat patch's height that they can reach in steps within
+/// [h_min, h_c].
+ShellPlan plan_shell(const TriangleMesh& mesh, const Analysis& a, const std::vector<int>& patches,
+                     const LayerParams& p);
+
+/// The shell's layer field: T = N + (z − H)/t, ζ = t·T, so the normalised mesh holds the
+/// shell's layers as planes ζ = j·t … (j + 1)·t. Every column is curved.
+class ShellField final : public LayerField {
+ public:
+  explicit ShellField(const ShellPlan& plan) : s_(plan) {}
+  double T(double x, double y, double z) const override {
+    return s_.N + (z - s_.top.height(x, y)) / s_.t;
+  }
+  double z_at(double x, double y, double t) const override {
+    return s_.top.height(x, y) + (t - s_.N) * s_.t;
+  }
+  double zeta(double t) const override { return t * s_.t; }
+  double t_of_zeta(double z) const override { return z / s_.t; }
+  double thickness(double, double, double) const override { return s_.t; }
+  bool planar_at(double, double) const override { return false; }
+  bool planar_along(const Vec2&, const Vec2&, double, double) const override { return false; }
+
+ private:
+  const ShellPlan& s_;
+};
+
+}  // namespace nonplanar::layers

@@ -1,0 +1,99 @@
+// The shell over a planar core (src/layers/shell_plan.hpp) on a wing rib whose top rises from
+// 0.3 mm to 12.3 mm: the core's stairs under the shell, the thickness of the layer that fills
+// them, and the parts it must refuse.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "layers/shell_plan.hpp"
+#include "support/solids.hpp"
+
+namespace nonplanar {
+namespace {
+
+double rib_top(double x) {
+  return 0.3 + 12 * std::sin(M_PI * x / 100);
+}
+
+std::vector<int> curved(const Analysis& a) {
+  std::vector<int> ids;
+  for (std::size_t i = 0; i < a.patches.size(); ++i)
+    if (a.patches[i].needs_nonplanar()) ids.push_back(static_cast<int>(i));
+  return ids;
+}
+
+layers::ShellPlan plan(const TriangleMesh& m) {
+  const Analysis a = *analyze(m, {}, {});
+  return layers::plan_shell(m, a, curved(a), LayerParams{});
+}
+
+// A closed box turned inside out: a void inside a solid (its floor faces up, its ceiling down).
+TriangleMesh void_box(const Vec3& lo, const Vec3& hi) {
+  TriangleMesh b = test::box(lo, hi);
+  for (auto& f : b.faces) std::swap(f[1], f[2]);
+  return b;
+}
+
+TEST(ShellPlan, RibStairsStayInsideTheLimits) {
+  const LayerParams lp;
+  const layers::ShellPlan s = plan(test::rib());
+  ASSERT_TRUE(s.refused.empty()) << s.refused;
+  EXPECT_EQ(s.N, 4);
+  EXPECT_DOUBLE_EQ(s.t, lp.layer_height);
+  EXPECT_NEAR(s.reach, lp.layer_height - lp.min_layer_height - 0.01, 1e-12);
+  // Core boundaries from the bed, each step in [h_min, h_max − h_min − 0.02].
+  ASSERT_GT(s.core.size(), 50u);
+  EXPECT_EQ(s.core.front(), 0.0);
+  for (std::size_t k = 1; k < s.core.size(); ++k) {
+    EXPECT_GE(s.core[k] - s.core[k - 1], lp.min_layer_height - 1e-9) << k;
+    EXPECT_LE(s.core[k] - s.core[k - 1], 0.18 + 1e-9) << k;
+  }
+  int filled = 0;
+  for (double x = 0.25; x < 80; x += 0.37)
+    for (double y = 0.5; y < 12; y += 1.1) {
+      // H is the rib's facets: within their sag (κ L² / 8 < 0.4 µm) of the analytic top.
+      EXPECT_NEAR(s.top.height(x, y), rib_top(x), 2e-3) << x;
+      const double B = s.bottom(x, y), Zc = s.core_top(x, y);
+      EXPECT_LE(Zc, std::max(B + s.reach, 0.0) + 1e-9);
+      if (B + s.reach >= s.core[1]) {
+        EXPECT_GT(Zc, B + s.reach - 0.18 - 1e-9) << x;
+      }
+      // The lowest shell layer, where it exists (its middle above the bed), fills the
+      // stairs within [h_min + 0.01, h_max − 0.01].
+      if (B + 0.5 * s.t > 0) {
+        const double t0 = s.thickness(0, x, y);
+        EXPECT_GE(t0, lp.min_layer_height + 0.01 - 1e-9) << x;
+        EXPECT_LE(t0, lp.max_layer_height - 0.01 + 1e-9) << x;
+        filled += B + s.reach >= s.core[1];
+      }
+      for (int j = 1; j < s.N; ++j)
+        if (s.layer_top(j - 1, x, y) >= 0) {
+          EXPECT_NEAR(s.thickness(j, x, y), s.t, 1e-12);
+        }
+    }
+  EXPECT_GT(filled, 1000);  // most of the rib has core under its shell
+}
+
+TEST(ShellPlan, CoreLandsOnAFlatFloorInside) {
+  TriangleMesh m = test::rib();
+  test::append(m, void_box({20, 3, 2.13}, {40, 9, 4}));
+  const layers::ShellPlan s = plan(m);
+  ASSERT_TRUE(s.refused.empty()) << s.refused;
+  bool landed = false;
+  for (double z : s.core) landed |= std::abs(z - 2.13) < 1e-9;
+  EXPECT_TRUE(landed);
+}
+
+TEST(ShellPlan, RefusesWhatTheShellCannotCover) {
+  TriangleMesh tower = test::rib();
+  test::append(tower, test::box({82, 4, 0}, {86, 8, 14}));
+  EXPECT_EQ(plan(tower).refused, layers::kNotOnTop);
+  // A void whose ceiling is 0.3 mm under the shell's bottom at x = 20 (B = 6.55 mm).
+  TriangleMesh hollow = test::rib();
+  test::append(hollow, void_box({20, 3, 5}, {40, 9, 6.25}));
+  const std::string why = plan(hollow).refused;
+  EXPECT_NE(why.find("overhang lies under the shell"), std::string::npos) << why;
+}
+
+}  // namespace
+}  // namespace nonplanar
