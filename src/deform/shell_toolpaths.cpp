@@ -27,13 +27,13 @@ Expected<std::vector<LayerToolpaths>> shell_toolpaths(const TriangleMesh& mesh,
   if (!core) return core.error();
   const auto [lo_it, hi_it] = std::minmax_element(plan.top.h.begin(), plan.top.h.end());
   const double h_lo = *lo_it, h_hi = *hi_it;
+  const layers::ContourIndex index(plan.top);
   tbb::parallel_for(std::size_t{0}, core->size(), [&](std::size_t k) {
     SlicedLayer& L = (*core)[k];
     const double level = L.z_top - plan.reach + plan.N * plan.t;
     if (level <= h_lo || L.islands.empty()) return;
-    L.islands = level > h_hi
-                    ? std::vector<ExPolygon>{}
-                    : clip::intersection_ex(L.islands, layers::region_at_least(plan.top, level));
+    L.islands = level > h_hi ? std::vector<ExPolygon>{}
+                             : clip::intersection_ex(L.islands, index.region_at_least(level));
   });
   while (!core->empty() && core->back().islands.empty()) core->pop_back();
   ctx.progress("core", 1.0);

@@ -101,10 +101,11 @@ Expected<bool> gate(SliceResult& r, const SliceJob& job, const layers::BandedFie
   return true;
 }
 
-// One attempt with the patches not in `excluded`. On a limit violation inside a curved band,
-// every such band's patch and what it broke are added to *offenders (the caller retries
-// without them; all thickness and slope offenders of one attempt are found at once).
-// Analysis and fitted surfaces: computed once, shared by every attempt.
+// One attempt with the patches not in `excluded`. When no stack can be built and `deferred` is
+// given, it is set and the result is returned unsliced (the caller tries a shell first). On a limit
+// violation inside a curved band, every such band's patch and what it broke are added to *offenders
+// (the caller retries without them; all thickness and slope offenders of one attempt are found at
+// once). Analysis and fitted surfaces: computed once, shared by every attempt.
 struct Prepared {
   Analysis analysis;
   std::vector<SurfaceFit> fits;
@@ -114,9 +115,10 @@ struct Prepared {
 
 Expected<SliceResult> attempt(const TriangleMesh& mesh, const SliceJob& job, const Prepared& pre,
                               const std::vector<int>& excluded,
-                              std::vector<std::pair<int, std::string>>* offenders,
+                              std::vector<std::pair<int, std::string>>* offenders, bool* deferred,
                               const Context& ctx) {
   offenders->clear();
+  if (deferred) *deferred = false;
   SliceResult r;
   r.header.push_back(std::string("mode: ") + (job.planar_only ? "planar" : "non-planar"));
   if (!job.planar_only) {
@@ -146,6 +148,8 @@ Expected<SliceResult> attempt(const TriangleMesh& mesh, const SliceJob& job, con
       for (const Patch& p : a->patches) candidates += p.needs_nonplanar();
       r.notices.push_back(candidates == 0 ? "no surface needs non-planar layers; slicing planar"
                                           : "no patch can be printed non-planar; slicing planar");
+      // The caller may print it as a shell instead (try_shell): slice planar only if not.
+      if (deferred && candidates > 0) return *deferred = true, r;
     } else {
       auto n = normalize_mesh(mesh, *r.plan.field, {}, ctx);
       if (!n) return n.error();
@@ -304,15 +308,23 @@ Expected<SliceResult> slice_model(const TriangleMesh& mesh, const SliceJob& job,
   std::vector<std::string> dropped;
   std::vector<std::pair<int, std::string>> offenders;
   for (int round = 0; round < 8; ++round) {
-    auto r = attempt(mesh, job, pre, excluded, &offenders, ctx);
+    bool deferred = false;
+    auto r = attempt(mesh, job, pre, excluded, &offenders, &deferred, ctx);
     if (!r) return r;
+    if (deferred) {
+      // No curved stack: a shell, or else the same attempt sliced planar (its stacks cached).
+      r->notices.insert(r->notices.begin(), dropped.begin(), dropped.end());
+      auto shell = try_shell(mesh, job, pre.analysis, *r, ctx);
+      if (!shell) return shell.error();
+      if (*shell) return std::move(**shell);
+      const std::vector<std::string> notices = std::move(r->notices);
+      r = attempt(mesh, job, pre, excluded, &offenders, nullptr, ctx);
+      if (!r) return r;
+      r->notices = notices;
+      return r;
+    }
     if (offenders.empty()) {
       r->notices.insert(r->notices.begin(), dropped.begin(), dropped.end());
-      if (!job.planar_only && !r->nonplanar) {
-        auto shell = try_shell(mesh, job, pre.analysis, *r, ctx);
-        if (!shell) return shell.error();
-        if (*shell) return std::move(**shell);
-      }
       return r;
     }
     // A stack that met every limit on its own grid broke one in the final paths: print

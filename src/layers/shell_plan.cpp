@@ -109,7 +109,7 @@ ShellPlan plan_shell(const TriangleMesh& mesh, const Analysis& a, const std::vec
       for (int i = 0; i < n; ++i) {
         const Vec3 q = A + (B - A) * (static_cast<double>(i) / n);
         if (q.z() > s.top.height(q.x(), q.y()) + 0.02) {
-          s.refused = at("the part stands above the patch", q);
+          s.refused = at("the part stands above the curved top", q);
           return s;
         }
       }
