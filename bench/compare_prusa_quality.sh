@@ -15,7 +15,7 @@ models=("$@")
 if ((${#models[@]} == 0)); then
   ./build/bench/make_test_solids "$tmp/solids"
   models=("$tmp"/solids/saddle.stl "$tmp"/solids/sine_roof.stl "$tmp"/solids/domed_towers.stl
-          "$tmp"/solids/dome_cut_by_box.stl ../shared/models/np_curvislicer_wing.stl
+          "$tmp"/solids/dome_cut_by_box.stl "$tmp"/solids/rib.stl ../shared/models/np_curvislicer_wing.stl
           ../shared/models/np_curvislicer_FoilCutter.stl ../shared/models/np_prusa_sphere.stl
           examples/wave_roof.stl)
 fi

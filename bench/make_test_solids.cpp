@@ -20,7 +20,8 @@ int main(int argc, char** argv) {
       {"saddle.stl", t::saddle()},
       {"sine_roof.stl", t::sine_roof()},
       {"domed_towers.stl", t::domed_towers()},
-      {"dome_cut_by_box.stl", t::dome_cut_by_box()}};
+      {"dome_cut_by_box.stl", t::dome_cut_by_box()},
+      {"rib.stl", t::rib()}};
   for (const auto& [name, mesh] : solids) {
     auto w = nonplanar::write_stl(dir / name, mesh);
     if (!w) {
