@@ -20,6 +20,10 @@ struct SlicedLayer {
   double z_bottom = 0, z_top = 0;  ///< the layer's span, mm
   double z_slice = 0;              ///< where the mesh was cut (mid-layer)
   std::vector<ExPolygon> islands;
+  /// What this layer covers for the top skins of the layers below, when that is more than
+  /// its islands (a core layer cut back under a shell, which covers the rest). Empty: the
+  /// islands.
+  std::vector<ExPolygon> covers;
 };
 
 /// Cuts the mesh at the middle of every layer (first layer first_layer_height, then

@@ -32,6 +32,9 @@ Expected<std::vector<LayerToolpaths>> shell_toolpaths(const TriangleMesh& mesh,
     SlicedLayer& L = (*core)[k];
     const double level = L.z_top - plan.reach + plan.N * plan.t;
     if (level <= h_lo || L.islands.empty()) return;
+    // The shell over the part cut away counts as cover for the skins below, so they are as
+    // thick (shell included) as top_solid_layers asks, not that plus the shell.
+    L.covers = L.islands;
     L.islands = level > h_hi ? std::vector<ExPolygon>{}
                              : clip::intersection_ex(L.islands, index.region_at_least(level));
   });

@@ -78,6 +78,9 @@ Expected<std::vector<LayerToolpaths>> make_toolpaths(const std::vector<SlicedLay
   if (stop) return Error{Status::cancelled, "cancelled"};
   ctx.progress("toolpaths", 0.4);
 
+  auto covers = [&](std::size_t k) -> const ExPolygons& {
+    return layers[k].covers.empty() ? layers[k].islands : layers[k].covers;
+  };
   std::vector<LayerToolpaths> out(n);
   tbb::parallel_for(std::size_t{0}, n, [&](std::size_t i) {
     if (stop || ctx.cancelled()) return stop = true, void();
@@ -101,8 +104,7 @@ Expected<std::vector<LayerToolpaths>> make_toolpaths(const std::vector<SlicedLay
         all_top = true;
         break;
       }
-      covered_above = j == 1 ? layers[i + j].islands
-                             : clip::intersection_ex(covered_above, layers[i + j].islands);
+      covered_above = j == 1 ? covers(i + j) : clip::intersection_ex(covered_above, covers(i + j));
     }
     for (int j = 1; j <= P.bottom_solid_layers; ++j) {
       if (static_cast<int>(i) - j < 0) {
@@ -125,7 +127,7 @@ Expected<std::vector<LayerToolpaths>> make_toolpaths(const std::vector<SlicedLay
       return u;
     }());
     const ExPolygons exposed =
-        i + 1 < n ? clip::intersection_ex(top, clip::diff_ex(fill, layers[i + 1].islands)) : top;
+        i + 1 < n ? clip::intersection_ex(top, clip::diff_ex(fill, covers(i + 1))) : top;
     const ExPolygons solid_inner = clip::diff_ex(solid, exposed);
     const ExPolygons sparse = clip::diff_ex(fill, solid);
 
