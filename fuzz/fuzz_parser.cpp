@@ -8,7 +8,25 @@
 #include "io/readers.hpp"
 #include "nonplanar/check.hpp"
 #include "nonplanar/config.hpp"
+#include "nonplanar/deform.hpp"
 #include "nonplanar/surface_io.hpp"
+
+#if NONPLANAR_FUZZ_PARSER == 8
+#include <cmath>
+namespace {
+// Layers 0.2 mm thick at x = 0, thicker and thinner along x (every column curved), so the
+// mapper resamples, scales and lifts as it does over a stack.
+struct Wave final : nonplanar::LayerField {
+  static double k(double x) { return 0.2 * (1 + 0.2 * std::sin(x / 5)); }
+  double T(double x, double, double z) const override { return z / k(x); }
+  double z_at(double x, double, double t) const override { return t * k(x); }
+  double zeta(double t) const override { return 0.2 * t; }
+  double t_of_zeta(double z) const override { return z / 0.2; }
+  double thickness(double x, double, double) const override { return k(x); }
+  bool planar_at(double, double) const override { return false; }
+};
+}  // namespace
+#endif
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   using namespace nonplanar;
@@ -30,8 +48,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   (void)parse_surfaces_json(in);
 #elif NONPLANAR_FUZZ_PARSER == 7
   (void)read_gcode_moves(in);
+#elif NONPLANAR_FUZZ_PARSER == 8
+  static const Wave field;
+  (void)map_foreign_gcode(in, field, {}, {});
 #else
-#error "NONPLANAR_FUZZ_PARSER must name a parser (0-7)"
+#error "NONPLANAR_FUZZ_PARSER must name a parser (0-8)"
 #endif
   return 0;
 }

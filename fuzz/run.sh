@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Run the libFuzzer targets (one per parser; AddressSanitizer + UndefinedBehaviorSanitizer).
 # Usage: fuzz/run.sh [SECONDS=60] [TARGET...]
-#   TARGET: stl obj off 3mf ini json surfaces gcode (default: all of them, two at a time).
+#   TARGET: stl obj off 3mf ini json surfaces gcode foreign (default: all of them, two at a
+#   time; foreign is the mapping of another slicer's G-code, map_foreign_gcode).
 # Builds the missing targets in build-san/ with scripts/sanitize.sh --build-only.
 # Seeds come from ../shared/models and tests/data; corpora grow in build-san/corpus/TARGET,
 # so longer runs pick up where the last one stopped. Findings are written to
@@ -12,7 +13,7 @@ cd "$(dirname "$0")/.."
 secs=${1:-60}
 shift || true
 targets=("$@")
-((${#targets[@]})) || targets=(stl obj off 3mf ini json surfaces gcode)
+((${#targets[@]})) || targets=(stl obj off 3mf ini json surfaces gcode foreign)
 out=${BUILD_DIR:-build-san}
 missing=0
 for t in "${targets[@]}"; do [[ -x "$out/fuzz/fuzz_$t" ]] || missing=1; done
@@ -33,7 +34,8 @@ seed stl "$models"/*.stl
 seed obj "$models"/*.obj
 seed off "$models"/*.off
 seed ini tests/data/*.ini
-mkdir -p "$out/corpus/json" "$out/corpus/surfaces" "$out/corpus/gcode" "$out/corpus/3mf"
+mkdir -p "$out/corpus/json" "$out/corpus/surfaces" "$out/corpus/gcode" "$out/corpus/3mf" \
+  "$out/corpus/foreign"
 printf '{"layer_height": 0.2, "fill_density": "20%%", "bed_shape": "0x0,220x0,220x220,0x220"}' \
   >"$out/corpus/json/profile.json"
 printf '%s' '{"format":"nonplanar-surfaces","version":1,"surfaces":[{"patch":0,"degree_u":2,'\
@@ -42,6 +44,8 @@ printf '%s' '{"format":"nonplanar-surfaces","version":1,"surfaces":[{"patch":0,"
 '[2,2,0,1]]]}]}' >"$out/corpus/surfaces/one.json"
 printf 'G90\nM83\nG92 E0\n;LAYER_CHANGE\n;Z:0.2\n;TYPE:Perimeter\nG1 X1 Y2 Z0.2 E0.5 F1200\nG1 E-0.8 F2100\nG0 X5 Y5\n' \
   >"$out/corpus/gcode/moves.gcode"
+printf 'M82\nG28\n;LAYER_CHANGE\n;Z:0.2\n;HEIGHT:0.2\nG1 Z.2 F7800\nG1 X10 Y10 F7800\n;TYPE:Perimeter\n;WIDTH:0.45\nG1 X30 Y10 E1.2 F1800\n;WIPE_START\nG1 X25 Y10 E-0.4\n;WIPE_END\nG1 E-0.8 F2400\nG92 E0\n;LAYER_CHANGE\n;Z:0.4\n;HEIGHT:0.2\nG1 Z.4\nG1 X40 Y40 F7800\nG1 E0.8\nG1 X45 Y40 E0.3\nM107\n;TYPE:Custom\nG28 X0\n' \
+  >"$out/corpus/foreign/two_layers.gcode"
 # A minimal 3MF package (one tetrahedron), zipped here so no binary lives in the repository.
 tmf=$(mktemp -d)
 mkdir -p "$tmf/_rels" "$tmf/3D"

@@ -4,8 +4,9 @@
 # nothing is missing. Run as root on Debian 12 (uses sudo when not root and available).
 #
 # Usage: scripts/setup.sh [--with-prusaslicer] [--with-clang]
-#   --with-prusaslicer  also install prusa-slicer (planar reference in benchmarks, external
-#                       engine); large, so only the benchmark/engine paths ask for it.
+#   --with-prusaslicer  also install prusa-slicer (planar reference in benchmarks, the
+#                       external engine and its tests); large, so only the test suite,
+#                       benchmarks and engine paths ask for it.
 #   --with-clang        also install clang-14 and its sanitizer/libFuzzer runtimes
 #                       (scripts/sanitize.sh, fuzz/run.sh).
 set -euo pipefail

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
-# Quick start, part 2: build, then run the whole test suite with ctest.
+# Quick start, part 2: build, then run the whole test suite with ctest. Installs prusa-slicer
+# too: the external-engine tests slice with it (they skip where it is missing).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-bash scripts/build.sh
+SETUP_ARGS="--with-prusaslicer ${SETUP_ARGS:-}" bash scripts/build.sh
 cd "${BUILD_DIR:-build}"
 ctest --output-on-failure -j"$(nproc)" --timeout 600

@@ -14,6 +14,7 @@ namespace {
 struct SliceOptions {
   MeshOptions mesh;
   std::string output, config;
+  std::string engine = "builtin", engine_path, engine_config, engine_filaments;
   bool planar = false;
   double max_angle = 30.0;
   // Overrides, applied by key after the profile, in this order.
@@ -24,8 +25,22 @@ struct SliceOptions {
 
 int run(const SliceOptions& o) {
   PrintConfig cfg;
-  if (!o.config.empty()) {
-    auto c = load_config(o.config);
+  EngineParams engine;
+  if (o.engine == "prusaslicer")
+    engine.engine = Engine::prusaslicer;
+  else if (o.engine == "orcaslicer")
+    engine.engine = Engine::orcaslicer;
+  else if (o.engine != "builtin")
+    return report_error({Status::invalid_argument,
+                         "--engine: '" + o.engine + "' is not builtin, prusaslicer or orcaslicer"});
+  engine.path = o.engine_path, engine.config = o.engine_config,
+  engine.filaments = o.engine_filaments;
+  // PrusaSlicer's profile is ours too (layer heights, bed, filament), unless --config names one.
+  const std::string profile = !o.config.empty()                      ? o.config
+                              : engine.engine == Engine::prusaslicer ? o.engine_config
+                                                                     : "";
+  if (!profile.empty()) {
+    auto c = load_config(profile);
     if (!c) return report_error(c.error());
     cfg = std::move(*c);
   }
@@ -36,14 +51,17 @@ int run(const SliceOptions& o) {
     return 0;
   };
   for (const auto& [key, value] : o.named)
-    if (!value->empty())
+    if (!value->empty()) {
       if (int rc = apply(key, *value)) return rc;
+      engine.overrides.emplace_back(key, *value);
+    }
   for (const std::string& kv : o.sets) {
     const auto eq = kv.find('=');
     if (eq == std::string::npos)
       return report_error(
           {Status::invalid_argument, "--set: expected KEY=VALUE, got '" + kv + "'"});
     if (int rc = apply(kv.substr(0, eq), kv.substr(eq + 1))) return rc;
+    engine.overrides.emplace_back(kv.substr(0, eq), kv.substr(eq + 1));
   }
   if (auto v = validate_config(cfg); !v) return report_error(v.error());
   if (!(o.max_angle > 0 && o.max_angle < 90))  // also catches NaN
@@ -66,6 +84,7 @@ int run(const SliceOptions& o) {
   }
   SliceJob job = make_job(cfg, o.max_angle);
   job.planar_only = o.planar;
+  job.engine = engine;
   auto result = slice_model(loaded->mesh, job, ctx);
   if (!result) {
     Error e = result.error();
@@ -74,7 +93,8 @@ int run(const SliceOptions& o) {
   }
   std::vector<std::string> header = result->header;
   header.push_back("model: " + o.mesh.model);
-  auto w = write_gcode_file(o.output, result->layers, cfg, header, ctx);
+  auto w = result->gcode.empty() ? write_gcode_file(o.output, result->layers, cfg, header, ctx)
+                                 : write_gcode_text(o.output, result->gcode, ctx);
   finish_progress();
   if (!w) return report_error(w.error());
   report_warnings(o.mesh.model, *loaded, o.mesh.quiet);
@@ -110,6 +130,16 @@ void register_slice(CLI::App& app, std::function<int()>* run_fn) {
   cmd->add_option("-o,--output", o->output, "G-code file to write (atomically)")->required();
   cmd->add_option("--config", o->config, "Profile: .json or PrusaSlicer .ini");
   cmd->add_flag("--planar", o->planar, "Planar layers only (the ordinary slicing engine)");
+  cmd->add_option("--engine", o->engine,
+                  "Planar engine for the normalised mesh: builtin, prusaslicer (PrusaSlicer 2.5+\n"
+                  "command line) or orcaslicer (untested); its G-code is mapped back")
+      ->capture_default_str();
+  cmd->add_option("--engine-path", o->engine_path,
+                  "The engine's executable (default: prusa-slicer / orca-slicer on PATH)");
+  cmd->add_option("--engine-config", o->engine_config,
+                  "The engine's profile: a PrusaSlicer .ini (also read as --config when that is\n"
+                  "not given), or OrcaSlicer's --load-settings \"machine.json;process.json\"");
+  cmd->add_option("--engine-filaments", o->engine_filaments, "OrcaSlicer's --load-filaments");
   cmd->add_option("--max-angle", o->max_angle,
                   "Steepest surface printed non-planar, degrees (nozzle geometry)")
       ->capture_default_str();

@@ -2,6 +2,9 @@
 // layers become planar, (x, y, z) ↦ (x, y, ζ(T(x, y, z))), subdividing where the map bends.
 #pragma once
 
+#include <string>
+#include <string_view>
+
 #include "nonplanar/context.hpp"
 #include "nonplanar/layers.hpp"
 #include "nonplanar/toolpaths.hpp"
@@ -31,6 +34,26 @@ Expected<std::vector<LayerToolpaths>> map_toolpaths_back(const std::vector<Layer
                                                          const LayerField& field,
                                                          const MapBackParams& params,
                                                          const Context& ctx);
+
+/// Another slicer's G-code of the normalised mesh, mapped back, and its extrusions (as paths
+/// with heights, for the same safety check as the built-in engine's).
+struct ForeignGcode {
+  std::string text;
+  std::vector<LayerToolpaths> layers;  ///< one per ;LAYER_CHANGE of the print
+};
+
+/// Maps a planar G-code file (PrusaSlicer's or OrcaSlicer's, or ours) sliced from the
+/// normalised mesh back onto the curved layers. Start and end G-code (before the first
+/// ;LAYER_CHANGE; from the ;TYPE:Custom after the last extrusion type) pass untouched, as do
+/// M-codes, tool changes, G4, G10/G11, G92 and the comments. Inside the print every G0/G1 is
+/// mapped: extrusions resampled and their E scaled by each piece's 3D length and layer
+/// thickness (as the built-in engine's paths), wipes laid on the layer, retractions kept,
+/// travels over curved layers lifted above them; ;Z: and ;HEIGHT: are recomputed (the
+/// layer's highest point and mean thickness); absolute or relative E as the file says.
+/// Errors (parse_error, naming the line): an arc, an unknown command or word inside the
+/// print, a move before the first layer, a file without ;LAYER_CHANGE.
+Expected<ForeignGcode> map_foreign_gcode(std::string_view text, const LayerField& field,
+                                         const MapBackParams& params, const Context& ctx);
 
 /// Splits every edge whose mapped midpoint is farther than the tolerance from the mapped
 /// chord (conforming: both faces of an edge split it), then maps every vertex. A closed,

@@ -23,4 +23,8 @@ Expected<bool> write_gcode_file(const std::filesystem::path& file,
                                 const std::vector<LayerToolpaths>& layers, const PrintConfig& c,
                                 const std::vector<std::string>& header, const Context& ctx);
 
+/// A whole program already made (another engine's, mapped) into a file, atomically.
+Expected<bool> write_gcode_text(const std::filesystem::path& file, const std::string& text,
+                                const Context& ctx);
+
 }  // namespace nonplanar

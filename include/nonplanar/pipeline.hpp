@@ -3,6 +3,7 @@
 #pragma once
 
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "nonplanar/check.hpp"
@@ -10,12 +11,28 @@
 
 namespace nonplanar {
 
+/// The planar engine that slices the (normalised) mesh.
+enum class Engine { builtin, prusaslicer, orcaslicer };
+
+struct EngineParams {
+  Engine engine = Engine::builtin;
+  std::string path;       ///< its executable; empty: prusa-slicer / orca-slicer on PATH
+  std::string config;     ///< PrusaSlicer: a profile .ini (--load); OrcaSlicer: --load-settings
+  std::string filaments;  ///< OrcaSlicer: --load-filaments
+  /// Settings the user overrode (PrusaSlicer keys and values), passed on to PrusaSlicer.
+  std::vector<std::pair<std::string, std::string>> overrides;
+};
+
 struct SliceJob {
   AnalysisParams analysis;
   FitParams fit;
   LayerParams layers;  ///< layer heights and printer limits; set from print by make_job
   PrintConfig print;
   bool planar_only = false;
+  /// Another slicer instead of the built-in engine: it slices the normalised mesh with the
+  /// user's profile and its G-code is mapped back (map_foreign_gcode). Layer heights and
+  /// the bed come from `print`, which must agree with that profile.
+  EngineParams engine;
 };
 
 /// A job whose layer and check settings agree with the print configuration.
@@ -30,6 +47,9 @@ struct SliceResult {
   std::size_t collisions = 0;
   bool nonplanar = false;
   int shell_layers = 0;  ///< curved layers of a shell over a planar core (0: none)
+  /// The whole program, when an external engine sliced it (its start and end G-code and
+  /// settings kept); empty: write `layers` with write_gcode_file.
+  std::string gcode;
 };
 
 /// Runs the pipeline on a mesh already placed on the bed. A violation of the printer limits

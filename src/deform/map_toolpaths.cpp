@@ -1,22 +1,15 @@
-// Inverse of the normalisation for toolpaths (DESIGN.md §2 step 6).
-//
-// Notation: a planar point (x, y, ζ) lies on layer boundary t = t(ζ); its real height is
-// z = z(x, y, t) and the layer under it spans t − Δt … t with Δt = t(ζ) − t(ζ − h).
+// Inverse of the normalisation for toolpaths (DESIGN.md §2 step 6); notation in
+// map_segment.hpp.
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <atomic>
 #include <cmath>
 
+#include "deform/map_segment.hpp"
 #include "nonplanar/deform.hpp"
 
 namespace nonplanar {
-namespace {
-
-struct Mapped {
-  Vec3 p;
-  double height;
-};
 
 Mapped map_point(const LayerField& f, const Vec3& q, double h_planar) {
   if (f.planar_at(q.x(), q.y())) return {q, h_planar};
@@ -26,10 +19,8 @@ Mapped map_point(const LayerField& f, const Vec3& q, double h_planar) {
   return {{q.x(), q.y(), z[0]}, z[0] - z[1]};
 }
 
-// Appends the mapped segment a → b (a already emitted), splitting at midpoints while the
-// mapped midpoint is farther than tol from the chord.
-void emit(const LayerField& f, const Vec3& a, const Mapped& ma, const Vec3& b, const Mapped& mb,
-          double h, double tol, int depth, ExtrusionPath& out) {
+void map_segment(const LayerField& f, const Vec3& a, const Mapped& ma, const Vec3& b,
+                 const Mapped& mb, double h, double tol, int depth, ExtrusionPath& out) {
   const Vec3 mid = 0.5 * (a + b);
   const Mapped mm = map_point(f, mid, h);
   // A midpoint on the chord proves nothing over a long segment (a symmetric wave passes the
@@ -42,13 +33,15 @@ void emit(const LayerField& f, const Vec3& a, const Mapped& ma, const Vec3& b, c
       !f.planar_along(a.head<2>(), b.head<2>(), f.t_of_zeta(a.z() - h), f.t_of_zeta(a.z()));
   if (depth < 16 && len > 0.02 &&
       ((curved && len > 1.0) || (mm.p - 0.5 * (ma.p + mb.p)).norm() > tol)) {
-    emit(f, a, ma, mid, mm, h, tol, depth + 1, out);
-    emit(f, mid, mm, b, mb, h, tol, depth + 1, out);
+    map_segment(f, a, ma, mid, mm, h, tol, depth + 1, out);
+    map_segment(f, mid, mm, b, mb, h, tol, depth + 1, out);
     return;
   }
   out.points.push_back(mb.p);
   out.height.push_back(mb.height);
 }
+
+namespace {
 
 bool is_top(const ExtrusionPath& p) {
   return p.role == ExtrusionRole::top_solid_infill;
@@ -80,7 +73,8 @@ Expected<std::vector<LayerToolpaths>> map_toolpaths_back(const std::vector<Layer
       q.height.push_back(prev.height);
       for (std::size_t k = 1; k < p.points.size(); ++k) {
         const Mapped cur = map_point(field, p.points[k], p.height[k]);
-        emit(field, p.points[k - 1], prev, p.points[k], cur, p.height[k], params.tolerance, 0, q);
+        map_segment(field, p.points[k - 1], prev, p.points[k], cur, p.height[k], params.tolerance,
+                    0, q);
         prev = cur;
       }
       for (std::size_t k = 0; k < q.points.size(); ++k) {

@@ -240,6 +240,12 @@ Expected<bool> write_gcode_file(const std::filesystem::path& file,
                                 const std::vector<std::string>& header, const Context& ctx) {
   auto text = make_gcode(layers, c, header, ctx);
   if (!text) return text.error();
+  return write_gcode_text(file, *text, ctx);
+}
+
+Expected<bool> write_gcode_text(const std::filesystem::path& file, const std::string& gcode,
+                                const Context& ctx) {
+  const std::string* text = &gcode;
   // Cancelled while writing: the writer removes its temporary, and no file appears.
   auto w = write_file_atomically(file, [&](std::ostream& out) {
     out.write(text->data(), static_cast<std::streamsize>(text->size()));

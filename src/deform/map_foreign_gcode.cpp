@@ -1,0 +1,406 @@
+// Mapping another slicer's planar G-code of the normalised mesh back onto the curved layers
+// (issue: libslic3r engine). Notation as in map_segment.hpp; E is filament length (mm).
+//
+// The file keeps its own program: start and end G-code, temperatures, fan, speeds and
+// retractions pass untouched. Inside the print (first ;LAYER_CHANGE to the ;TYPE:Custom
+// that follows the last typed extrusion), each G0/G1 is mapped: an extrusion is resampled
+// like the built-in engine's paths and each piece's E scaled by its own 3D length and layer
+// thickness against the planar ones (L·t / (L_p·h)); a wipe follows the layer with its E
+// spread over the pieces; a travel over curved layers rises above the layer's highest point
+// (or, for a hop under 0.6 mm, its slope's reach) and comes down at the target, as the
+// built-in writer does.
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdarg>
+#include <cstdio>
+#include <limits>
+
+#include "deform/map_segment.hpp"
+#include "io/mesh_buffer.hpp"
+#include "nonplanar/deform.hpp"
+
+namespace nonplanar {
+namespace {
+
+constexpr double kTipRadius = 0.4;  // the writer's short-hop reach (gcode_writer.cpp)
+constexpr double kNone = std::numeric_limits<double>::quiet_NaN();
+
+struct Move {
+  int line = 0;
+  Vec3 from, to;  ///< planar
+  double de = 0;  ///< filament pushed (negative: retraction)
+  bool has_xy = false, has_z = false, has_e = false;
+  double f = kNone;  ///< feed rate, if the line had one
+  bool wipe = false;
+  std::string type;
+  double width = 0.45, h = 0.2;  ///< ;WIDTH: and the planar layer's ;HEIGHT:
+  bool extruding() const { return de > 0 && has_xy && (to - from).head<2>().norm() > 1e-9; }
+};
+
+// One input line: untouched text, or a move of the print (index into moves), or a layer's
+// ;Z: / ;HEIGHT: comment (rewritten).
+struct Item {
+  enum Kind { text, move, z_comment, height_comment, e_reset, e_mode } kind = text;
+  std::string_view raw;
+  int index = -1;
+  double value = 0;  ///< e_reset: the new E; e_mode: 1 relative, 0 absolute
+  int layer = -1;
+};
+
+ExtrusionRole role_of(const std::string& type) {
+  if (type == "External perimeter" || type == "Overhang perimeter")
+    return ExtrusionRole::external_perimeter;
+  if (type == "Perimeter") return ExtrusionRole::perimeter;
+  if (type == "Internal infill") return ExtrusionRole::internal_infill;
+  if (type == "Top solid infill" || type == "Ironing") return ExtrusionRole::top_solid_infill;
+  if (type == "Skirt/Brim" || type == "Skirt" || type == "Brim") return ExtrusionRole::skirt;
+  return ExtrusionRole::solid_infill;
+}
+
+class Writer {
+ public:
+  Writer(bool rel_e) : rel_e_(rel_e) {}
+  std::string out;
+  void raw(std::string_view s) {
+    out.append(s);
+    out.push_back('\n');
+  }
+  void line(const char* fmt, ...) __attribute__((format(printf, 2, 3))) {
+    char buf[256];
+    va_list ap;
+    va_start(ap, fmt);
+    std::vsnprintf(buf, sizeof buf, fmt, ap);
+    va_end(ap);
+    raw(buf);
+  }
+  // A move to p (mapped) pushing de of filament; F only where the input had it.
+  // E and F are written only where given (NaN: not given).
+  void move(const Vec3& p, const Vec3& from, double e, double f) {
+    std::string s = "G1";
+    char buf[64];
+    if (std::abs(p.x() - from.x()) > 5e-4 || std::abs(p.y() - from.y()) > 5e-4) {
+      std::snprintf(buf, sizeof buf, " X%.3f Y%.3f", p.x(), p.y());
+      s += buf;
+    }
+    if (std::abs(p.z() - from.z()) > 5e-4) {
+      std::snprintf(buf, sizeof buf, " Z%.3f", p.z());
+      s += buf;
+    }
+    if (!std::isnan(e)) {
+      e_ += e;
+      std::snprintf(buf, sizeof buf, " E%.5f", rel_e_ ? e : e_);
+      s += buf;
+    }
+    if (!std::isnan(f)) {
+      std::snprintf(buf, sizeof buf, " F%d", static_cast<int>(std::lround(f)));
+      s += buf;
+    }
+    if (s.size() > 2) raw(s);
+  }
+  void set_e(double e) { e_ = e; }
+  void set_relative(bool r) { rel_e_ = r; }
+
+ private:
+  bool rel_e_;
+  double e_ = 0;
+};
+
+}  // namespace
+
+Expected<ForeignGcode> map_foreign_gcode(std::string_view text, const LayerField& field,
+                                         const MapBackParams& params, const Context& ctx) {
+  if (!(params.tolerance > 0)) return Error{Status::invalid_argument, "map tolerance: must be > 0"};
+  // Split into lines; find where the print ends: the first ;TYPE:Custom after the last other
+  // ;TYPE: (PrusaSlicer's and OrcaSlicer's end G-code follow one), else the end of the file.
+  std::vector<std::string_view> lines;
+  for (std::size_t start = 0; start < text.size();) {
+    std::size_t end = text.find('\n', start);
+    if (end == std::string_view::npos) end = text.size();
+    std::string_view l = text.substr(start, end - start);
+    if (!l.empty() && l.back() == '\r') l.remove_suffix(1);
+    lines.push_back(l);
+    start = end + 1;
+  }
+  std::size_t first_layer = lines.size(), last_typed = 0, print_end = lines.size();
+  for (std::size_t i = 0; i < lines.size(); ++i) {
+    const std::string_view l = lines[i];
+    if (first_layer == lines.size() && l.rfind(";LAYER_CHANGE", 0) == 0) first_layer = i;
+    if (l.rfind(";TYPE:", 0) == 0 && l.rfind(";TYPE:Custom", 0) != 0) last_typed = i;
+  }
+  if (first_layer == lines.size())
+    return Error{Status::parse_error, "no ;LAYER_CHANGE: not a layered G-code file"};
+  for (std::size_t i = std::max(last_typed, first_layer); i < lines.size(); ++i)
+    if (lines[i].rfind(";TYPE:Custom", 0) == 0) {
+      print_end = i;
+      break;
+    }
+
+  // Pass 1: parse every line, keeping state across the whole file.
+  std::vector<Move> moves;
+  std::vector<Item> items;
+  std::vector<double> layer_h;  // planar ;HEIGHT: per layer
+  Vec3 pos(0, 0, 0);
+  double e = 0, width = 0.45, h = 0.2;
+  bool rel_e = false, rel_xyz = false, wipe = false, rel_e_at_print = false;
+  bool layer_header = false;  // between ;LAYER_CHANGE and the layer's ;HEIGHT:
+  double e_at_end = 0, e_at_print = 0;
+  std::string type;
+  int layer = -1;
+  for (std::size_t i = 0; i < lines.size(); ++i) {
+    const int line = static_cast<int>(i) + 1;
+    auto fail = [&](const std::string& why) {
+      return Error{Status::parse_error, "line " + std::to_string(line) + ": " + why};
+    };
+    const bool in_print = i >= first_layer && i < print_end;
+    if (i == first_layer) rel_e_at_print = rel_e, e_at_print = e;
+    if (i == print_end) e_at_end = e;
+    std::string_view l = lines[i];
+    Item item;
+    item.raw = l;
+    item.layer = layer;
+    const std::size_t semi = l.find(';');
+    if (semi != std::string_view::npos) {
+      const std::string_view c = l.substr(semi);
+      if (c.rfind(";TYPE:", 0) == 0) type = std::string(c.substr(6));
+      if (c.rfind(";WIDTH:", 0) == 0)
+        if (auto w = io::parse_double(c.substr(7)); w && *w > 0) width = *w;
+      if (c.rfind(";WIPE_START", 0) == 0) wipe = true;
+      if (c.rfind(";WIPE_END", 0) == 0) wipe = false;
+      if (in_print && c.rfind(";LAYER_CHANGE", 0) == 0)
+        item.layer = ++layer, layer_h.push_back(h), layer_header = true;
+      // The layer's thickness is the ;HEIGHT: of its header; later ones are a bead's (a
+      // bridge's is the nozzle's diameter) and pass untouched.
+      if (in_print && layer_header && c.rfind(";HEIGHT:", 0) == 0 && semi == 0) {
+        if (auto v = io::parse_double(c.substr(8)); v && *v > 0) h = *v, layer_h.back() = h;
+        item.kind = Item::height_comment;
+        layer_header = false;
+      }
+      if (in_print && c.rfind(";Z:", 0) == 0 && semi == 0) item.kind = Item::z_comment;
+      l = l.substr(0, semi);
+    }
+    io::Tokenizer tok(l);
+    const std::string_view cmd = tok.next();
+    if (cmd.empty()) {
+      items.push_back(item);
+      continue;
+    }
+    const char kind = static_cast<char>(std::toupper(static_cast<unsigned char>(cmd[0])));
+    const auto num = io::parse_int(cmd.substr(1));
+    if (kind == 'M' && num && (*num == 82 || *num == 83)) {
+      rel_e = *num == 83;
+      item.kind = Item::e_mode, item.value = rel_e;
+    }
+    if (kind == 'G' && num && (*num == 90 || *num == 91)) rel_xyz = *num == 91;
+    if (kind == 'G' && num && *num == 92) {
+      for (std::string_view w = tok.next(); !w.empty(); w = tok.next()) {
+        const auto v = io::parse_double(w.substr(1));
+        const char a = static_cast<char>(std::toupper(static_cast<unsigned char>(w[0])));
+        if (!v) {
+          if (in_print) return fail("bad number in G92");
+          continue;
+        }
+        if (a == 'E') e = *v, item.kind = Item::e_reset, item.value = *v;
+        if (a == 'X') pos.x() = *v;
+        if (a == 'Y') pos.y() = *v;
+        if (a == 'Z') pos.z() = *v;
+      }
+    } else if (kind == 'G' && num && (*num == 0 || *num == 1)) {
+      Move m;
+      m.line = line, m.from = pos, m.to = pos;
+      for (std::string_view w = tok.next(); !w.empty(); w = tok.next()) {
+        const char a = static_cast<char>(std::toupper(static_cast<unsigned char>(w[0])));
+        const auto v = io::parse_double(w.substr(1));
+        if (!v) {
+          if (in_print) return fail("bad number in '" + std::string(w.substr(0, 30)) + "'");
+          continue;
+        }
+        if (a == 'X')
+          m.to.x() = rel_xyz ? m.to.x() + *v : *v, m.has_xy = true;
+        else if (a == 'Y')
+          m.to.y() = rel_xyz ? m.to.y() + *v : *v, m.has_xy = true;
+        else if (a == 'Z')
+          m.to.z() = rel_xyz ? m.to.z() + *v : *v, m.has_z = true;
+        else if (a == 'E')
+          m.has_e = true, m.de = rel_e ? *v : *v - e, e = rel_e ? e + *v : *v;
+        else if (a == 'F')
+          m.f = *v;
+        else if (in_print)
+          return fail("unknown word '" + std::string(w.substr(0, 20)) + "' in a move");
+      }
+      // No printer is 10 m across: such a coordinate is a broken file, and mapping its
+      // moves in 1 mm pieces would not fit in memory.
+      if (in_print && m.to.cwiseAbs().maxCoeff() > 1e4)
+        return fail("coordinate beyond 10 m: not a print this can map");
+      pos = m.to;
+      if (in_print) {
+        if (layer < 0) return fail("a move before the first layer");
+        m.wipe = wipe, m.type = type, m.width = width, m.h = h;
+        item.kind = Item::move;
+        item.index = static_cast<int>(moves.size());
+        moves.push_back(std::move(m));
+      }
+    } else if (in_print) {
+      if (kind == 'G' && num && (*num == 2 || *num == 3))
+        return fail("arc move (G2/G3) cannot be mapped onto curved layers; turn arc fitting off");
+      const bool known = kind == 'M' || kind == 'T' ||
+                         (kind == 'G' && num &&
+                          (*num == 4 || *num == 10 || *num == 11 || *num == 21 || *num == 90 ||
+                           *num == 91 || *num == 92));
+      if (!known || (kind != 'T' && !num))
+        return fail("'" + std::string(cmd.substr(0, 20)) +
+                    "' inside the print cannot be mapped onto curved layers");
+    }
+    items.push_back(item);
+  }
+  if (print_end == lines.size()) e_at_end = e;
+  if (ctx.cancelled()) return Error{Status::cancelled, "cancelled"};
+
+  // Pass 2, a layer at a time: map its extrusions and wipes first (their highest point and
+  // steepest slope set how its travels clear it), then write its lines in order.
+  ForeignGcode out;
+  out.layers.resize(layer_h.size());
+  Writer w(rel_e_at_print);
+  std::vector<ExtrusionPath> mapped(moves.size());
+  Vec3 at(0, 0, 0);  // the nozzle, mapped
+  std::size_t points = 0;
+  std::size_t i = 0;
+  for (; i < first_layer; ++i) w.raw(items[i].raw);
+  if (!moves.empty()) at = moves.front().from;
+  w.set_e(e_at_print);  // absolute E continues from the untouched start G-code
+  while (i < print_end) {
+    std::size_t j = i + 1;
+    while (j < print_end && items[j].raw.rfind(";LAYER_CHANGE", 0) != 0) ++j;
+    const int li = items[i].layer;
+    LayerToolpaths& L = out.layers[static_cast<std::size_t>(std::max(li, 0))];
+    L.max_z = -1e300;
+    // Map the layer's extrusions and wipes.
+    for (std::size_t k = i; k < j; ++k) {
+      if (items[k].kind != Item::move) continue;
+      const Move& m = moves[static_cast<std::size_t>(items[k].index)];
+      if (!m.has_xy || !(m.extruding() || (m.wipe && m.de <= 0))) continue;
+      ExtrusionPath& p = mapped[static_cast<std::size_t>(items[k].index)];
+      const Mapped a = map_point(field, m.from, m.h), b = map_point(field, m.to, m.h);
+      p.points.push_back(a.p);
+      p.height.push_back(a.height);
+      map_segment(field, m.from, a, m.to, b, m.h, params.tolerance, 0, p);
+      points += p.points.size();
+      if (points > 50'000'000)
+        return Error{Status::invalid_argument,
+                     "line " + std::to_string(m.line) + ": more than 50 million mapped points"};
+      for (std::size_t q = 0; q < p.points.size(); ++q) {
+        L.max_z = std::max(L.max_z, p.points[q].z());
+        if (q == 0) continue;
+        const double dxy = (p.points[q] - p.points[q - 1]).head<2>().norm();
+        if (dxy > 1e-3)
+          L.max_slope =
+              std::max(L.max_slope, std::abs(p.points[q].z() - p.points[q - 1].z()) / dxy);
+      }
+    }
+    if (L.max_z < -1e299) L.max_z = 0;
+    // Write.
+    double h_sum = 0;
+    std::size_t h_n = 0;
+    ExtrusionPath* run = nullptr;  // the gate's path being extended
+    for (std::size_t k = i; k < j; ++k) {
+      const Item& it = items[k];
+      if (it.kind == Item::text || it.kind == Item::e_reset || it.kind == Item::e_mode) {
+        w.raw(it.raw);
+        if (it.kind == Item::e_reset) w.set_e(it.value);
+        if (it.kind == Item::e_mode) w.set_relative(it.value != 0);
+        continue;
+      }
+      if (it.kind == Item::z_comment || it.kind == Item::height_comment) {
+        // Recomputed once the layer is written: placeholders filled below.
+        w.raw(it.kind == Item::z_comment ? ";Z:@" : ";HEIGHT:@");
+        continue;
+      }
+      const Move& m = moves[static_cast<std::size_t>(it.index)];
+      const ExtrusionPath& p = mapped[static_cast<std::size_t>(it.index)];
+      if (!p.points.empty()) {
+        // Extrusion or wipe: one G1 per piece.
+        const double lp = (m.to - m.from).norm();
+        double l3 = 0;
+        for (std::size_t q = 1; q < p.points.size(); ++q)
+          l3 += (p.points[q] - p.points[q - 1]).norm();
+        double f = m.f;
+        if (m.extruding() && !run) {
+          ExtrusionPath g;
+          g.role = role_of(m.type), g.width = m.width;
+          g.points.push_back(p.points[0]);
+          g.height.push_back(p.height[0]);
+          L.paths.push_back(std::move(g));
+          run = &L.paths.back();
+        }
+        for (std::size_t q = 1; q < p.points.size(); ++q) {
+          const double seg = (p.points[q] - p.points[q - 1]).norm();
+          double de;
+          if (m.extruding()) {
+            const double hq = 0.5 * (p.height[q] + p.height[q - 1]);
+            de = lp > 0 ? m.de * (seg / lp) * (hq / m.h) : 0;
+            run->points.push_back(p.points[q]);
+            run->height.push_back(p.height[q]);
+            h_sum += p.height[q], ++h_n;
+          } else {
+            de = l3 > 0 ? m.de * seg / l3 : 0;
+          }
+          w.move(p.points[q], at, m.has_e ? de : kNone, f);
+          f = kNone;
+          at = p.points[q];
+        }
+        if (!m.extruding()) run = nullptr;
+        continue;
+      }
+      run = nullptr;
+      if (!m.has_xy && !m.has_z) {  // retraction, F only
+        w.move(at, at, m.has_e ? m.de : kNone, m.f);
+        continue;
+      }
+      // A travel (or a Z move): to the target's place on its layer.
+      const Mapped target = map_point(field, m.to, m.h);
+      const Vec3 to = target.p;
+      const bool curved =
+          target.p.z() != m.to.z() || !field.planar_at(m.from.x(), m.from.y()) ||
+          !field.planar_along(m.from.head<2>(), m.to.head<2>(), field.t_of_zeta(m.to.z() - m.h),
+                              field.t_of_zeta(m.to.z()));
+      const double d = (to - at).head<2>().norm();
+      const double hop = L.max_slope * (0.5 * d + kTipRadius);
+      const double de = m.has_e ? m.de : kNone;
+      if (curved && m.has_xy && (d > 0.6 || std::abs(to.z() - at.z()) > 0.1 || hop > 0.05)) {
+        const double lift = d > 0.6 || std::abs(to.z() - at.z()) > 0.1
+                                ? std::max({L.max_z, at.z(), to.z()}) + 0.3
+                                : std::max(at.z(), to.z()) + hop + 0.05;
+        const Vec3 up(at.x(), at.y(), lift), over(to.x(), to.y(), lift);
+        w.move(up, at, kNone, m.f);
+        w.move(over, up, kNone, kNone);
+        w.move(to, over, de, kNone);
+      } else {
+        w.move(to, at, de, m.f);
+      }
+      at = to;
+    }
+    // Fill the layer's ;Z: (its highest point) and ;HEIGHT: (its mean thickness).
+    char zbuf[32], hbuf[32];
+    std::snprintf(zbuf, sizeof zbuf, ";Z:%.3f", L.max_z);
+    std::snprintf(hbuf, sizeof hbuf, ";HEIGHT:%.3f",
+                  h_n ? h_sum / static_cast<double>(h_n)
+                      : layer_h[static_cast<std::size_t>(std::max(li, 0))]);
+    for (const char* key : {";Z:@", ";HEIGHT:@"}) {
+      const std::size_t at_key = w.out.rfind(key);
+      if (at_key != std::string::npos)
+        w.out.replace(at_key, std::string(key).size(), key[1] == 'Z' ? zbuf : hbuf);
+    }
+    L.z = L.max_z;
+    L.height = layer_h[static_cast<std::size_t>(std::max(li, 0))];
+    L.nonplanar = true;
+    i = j;
+    if (ctx.cancelled()) return Error{Status::cancelled, "cancelled"};
+  }
+  // The end G-code as written, after telling the firmware the file's own E (absolute E).
+  if (print_end < lines.size() && !rel_e_at_print) w.line("G92 E%.5f", e_at_end);
+  for (; i < lines.size(); ++i) w.raw(items[i].raw);
+  out.text = std::move(w.out);
+  return out;
+}
+
+}  // namespace nonplanar

@@ -1,0 +1,164 @@
+#include "slice/external_engine.hpp"
+
+#include <fcntl.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <thread>
+
+#include "nonplanar/io.hpp"
+
+extern char** environ;
+
+namespace nonplanar {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string num(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
+
+// A temporary folder, removed with everything in it when this goes out of scope.
+struct TempDir {
+  fs::path path;
+  TempDir() {
+    std::string t = (fs::temp_directory_path() / "nonplanar-engine-XXXXXX").string();
+    if (mkdtemp(t.data())) path = t;
+  }
+  ~TempDir() {
+    std::error_code ec;
+    if (!path.empty()) fs::remove_all(path, ec);
+  }
+};
+
+std::string last_line(const fs::path& log) {
+  std::ifstream in(log);
+  std::string line, last;
+  while (std::getline(in, line))
+    if (line.find_first_not_of(" \t\r") != std::string::npos &&
+        line.find("[trace]") == std::string::npos)
+      last = line;
+  if (last.size() > 200) last = last.substr(0, 200) + "...";
+  return last;
+}
+
+}  // namespace
+
+std::vector<std::string> engine_forced_settings(const EngineParams& e, const PrintConfig& c) {
+  if (e.engine == Engine::builtin) return {};
+  // OrcaSlicer's command line cannot override them: they are what its profile must say.
+  const std::string how = e.engine == Engine::orcaslicer ? "required of the profile, " : "";
+  std::vector<std::string> s = {
+      "layer_height = " + num(c.slice.layer_height) + " (the normalised layers)",
+      "first_layer_height = " + num(c.slice.first_layer_height),
+      "spiral_vase = 0",
+      "retract_lift = 0 (travel lifts over curved layers are nonplanar's)",
+      "arc_fitting = disabled",
+      std::string("E distances: ") + (c.gcode.relative_e ? "relative" : "absolute") +
+          " (as the profile says)"};
+  for (std::string& v : s) v = how + v;
+  return s;
+}
+
+Expected<std::string> run_engine(const EngineParams& e, const TriangleMesh& mesh,
+                                 const PrintConfig& c, const Context& ctx) {
+  const bool orca = e.engine == Engine::orcaslicer;
+  const std::string name = orca ? "OrcaSlicer" : "PrusaSlicer";
+  const std::string exe = !e.path.empty() ? e.path : orca ? "orca-slicer" : "prusa-slicer";
+  TempDir dir;
+  if (dir.path.empty()) return Error{Status::io_error, "engine: cannot make a temporary folder"};
+  const fs::path stl = dir.path / "normalized.stl", out = dir.path / "out.gcode",
+                 log = dir.path / "engine.log", forced = dir.path / "forced.ini";
+  if (auto w = write_stl(stl, mesh); !w) return w.error();
+  const Vec2 centre = c.bed_center();
+  std::vector<std::string> args{exe};
+  if (!orca) {
+    // Keys an older PrusaSlicer does not know (arc_fitting, 2.6+) are ignored in a loaded
+    // file but fatal on the command line, so they go in a file loaded last.
+    std::ofstream(forced) << "arc_fitting = disabled\nspiral_vase = 0\nretract_lift = 0\n";
+    args.push_back("--export-gcode");
+    if (!e.config.empty()) args.insert(args.end(), {"--load", e.config});
+    args.insert(args.end(),
+                {"--load", forced.string(), "--layer-height", num(c.slice.layer_height),
+                 "--first-layer-height", num(c.slice.first_layer_height), "--retract-lift", "0",
+                 "--no-spiral-vase", "--center", num(centre.x()) + "," + num(centre.y())});
+    if (e.config.empty()) {
+      char bed[160];
+      std::snprintf(bed, sizeof bed, "%gx%g,%gx%g,%gx%g,%gx%g", c.bed_min.x(), c.bed_min.y(),
+                    c.bed_max.x(), c.bed_min.y(), c.bed_max.x(), c.bed_max.y(), c.bed_min.x(),
+                    c.bed_max.y());
+      args.insert(args.end(),
+                  {"--bed-shape", bed, "--nozzle-diameter", num(c.paths.nozzle_diameter),
+                   "--filament-diameter", num(c.gcode.filament_diameter)});
+    }
+    for (const auto& [key, value] : e.overrides) {
+      if (key == "retract_lift" || key == "spiral_vase" || key == "arc_fitting" ||
+          key == "layer_height" || key == "first_layer_height")
+        continue;  // forced above (the layer heights are the same values)
+      std::string flag = "--" + key;
+      for (char& ch : flag)
+        if (ch == '_') ch = '-';
+      args.insert(args.end(), {flag, value});
+    }
+    args.insert(args.end(), {"--output", out.string(), stl.string()});
+  } else {
+    // OrcaSlicer's documented command line (untested here: it is not packaged for Debian).
+    args.insert(args.end(), {"--slice", "0", "--outputdir", dir.path.string()});
+    if (!e.config.empty()) args.insert(args.end(), {"--load-settings", e.config});
+    if (!e.filaments.empty()) args.insert(args.end(), {"--load-filaments", e.filaments});
+    args.push_back(stl.string());
+  }
+  std::vector<char*> argv;
+  for (std::string& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  posix_spawn_file_actions_t fa;
+  posix_spawn_file_actions_init(&fa);
+  posix_spawn_file_actions_addopen(&fa, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_adddup2(&fa, 1, 2);
+  posix_spawn_file_actions_addopen(&fa, 0, "/dev/null", O_RDONLY, 0);
+  pid_t pid = 0;
+  const int rc = posix_spawnp(&pid, exe.c_str(), &fa, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&fa);
+  if (rc != 0)
+    return Error{Status::io_error, "engine: cannot run '" + exe + "' (" + name +
+                                       " not installed? --engine-path names it)"};
+  int status = 0;
+  for (;;) {
+    const pid_t w = waitpid(pid, &status, WNOHANG);
+    if (w == pid) break;
+    if (w < 0) return Error{Status::io_error, "engine: lost track of " + name};
+    if (ctx.cancelled()) {
+      kill(pid, SIGTERM);
+      waitpid(pid, &status, 0);
+      return Error{Status::cancelled, "cancelled"};
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  fs::path result = out;
+  if (orca) {  // it names its output itself (plate_1.gcode)
+    result.clear();
+    std::error_code ec;
+    for (const auto& f : fs::directory_iterator(dir.path, ec))
+      if (f.path().extension() == ".gcode") result = f.path();
+  }
+  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0 || result.empty() || !fs::exists(result)) {
+    const std::string why = last_line(log);
+    return Error{Status::io_error, "engine: " + name + " failed" + (why.empty() ? "" : ": " + why)};
+  }
+  std::ifstream in(result, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+}  // namespace nonplanar

@@ -1,0 +1,106 @@
+// map_foreign_gcode (src/deform/map_foreign_gcode.cpp): a planar G-code file of the normalised
+// mesh, here written by our own planar engine, mapped back onto the curved layers must print
+// as well as the built-in route; what it cannot map is refused with its line.
+#include <gtest/gtest.h>
+
+#include "nonplanar/check.hpp"
+#include "nonplanar/deform.hpp"
+#include "nonplanar/fit.hpp"
+#include "nonplanar/gcode.hpp"
+#include "nonplanar/pipeline.hpp"
+#include "support/solids.hpp"
+
+namespace nonplanar {
+namespace {
+
+TriangleMesh placed(TriangleMesh m, const PrintConfig& c) {
+  const BoundingBox b = bounding_box(m);
+  const Vec3 shift(c.bed_center().x() - 0.5 * (b.min.x() + b.max.x()),
+                   c.bed_center().y() - 0.5 * (b.min.y() + b.max.y()), -b.min.z());
+  for (Vec3& v : m.vertices) v += shift;
+  return m;
+}
+
+CheckFigures figures(const std::string& gcode, const TriangleMesh& mesh) {
+  auto moves = read_gcode_moves(gcode);
+  EXPECT_TRUE(moves) << moves.error().message;
+  auto f = check_print(*moves, &mesh, {}, {});
+  EXPECT_TRUE(f);
+  return *f;
+}
+
+TEST(MapForeignGcode, PlanarFileOfTheNormalisedSaddlePrintsLikeTheBuiltInRoute) {
+  PrintConfig c;
+  c.paths.fill_density = 1.0;
+  const TriangleMesh mesh = placed(test::saddle(), c);
+  const SliceJob job = make_job(c);
+  auto a = analyze(mesh, job.analysis, {});
+  ASSERT_TRUE(a);
+  std::vector<int> ids;
+  auto fits = fit_patches(mesh, *a, job.fit, {}, &ids, {});
+  ASSERT_TRUE(fits);
+  auto plan = plan_layers(mesh, *a, *fits, ids, job.layers, {});
+  ASSERT_TRUE(plan);
+  ASSERT_EQ(plan->stacks.size(), 1u);
+  auto n = normalize_mesh(mesh, *plan->field, {}, {});
+  ASSERT_TRUE(n);
+  auto sliced = slice_mesh(n->mesh, c.slice, {});
+  ASSERT_TRUE(sliced);
+  auto paths = make_toolpaths(*sliced, c.paths, {});
+  ASSERT_TRUE(paths);
+  auto planar = make_gcode(*paths, c, {}, {});
+  ASSERT_TRUE(planar);
+
+  auto mapped = map_foreign_gcode(*planar, *plan->field, {}, {});
+  ASSERT_TRUE(mapped) << mapped.error().message;
+  const CheckFigures f = figures(mapped->text, mesh);
+  EXPECT_LE(f.deviation_p95, 0.02);
+  EXPECT_GT(f.covered_samples, 0.95 * static_cast<double>(f.surface_samples));
+  EXPECT_EQ(f.collisions, 0u);
+  EXPECT_LE(f.steepest_deg, job.layers.max_angle_deg + 0.5);
+  EXPECT_GE(f.thickness_min, job.layers.min_layer_height - 1e-3);
+  EXPECT_LE(f.thickness_max, job.layers.max_layer_height + 1e-3);
+  EXPECT_NEAR(f.volume_ratio, 1.0, 0.03);
+  // The built-in route on the same part, for comparison: the same layers, so nearly the same
+  // volume and deviation.
+  auto builtin = slice_model(mesh, job, {});
+  ASSERT_TRUE(builtin);
+  auto text = make_gcode(builtin->layers, c, {}, {});
+  ASSERT_TRUE(text);
+  const CheckFigures g = figures(*text, mesh);
+  EXPECT_NEAR(f.volume_ratio, g.volume_ratio, 0.01);
+  EXPECT_NEAR(f.deviation_p95, g.deviation_p95, 0.005);
+  // The paths handed to the safety check carry the mapped thickness.
+  double hmin = 1e9, hmax = 0;
+  for (std::size_t li = 1; li < mapped->layers.size(); ++li)
+    for (const ExtrusionPath& p : mapped->layers[li].paths)
+      for (double h : p.height) hmin = std::min(hmin, h), hmax = std::max(hmax, h);
+  EXPECT_GE(hmin, job.layers.min_layer_height - 1e-3);
+  EXPECT_LE(hmax, job.layers.max_layer_height + 1e-3);
+  EXPECT_LT(hmin, 0.19);  // some layers really are thinner than planar ...
+  EXPECT_GT(hmax, 0.21);  // ... and some thicker
+}
+
+TEST(MapForeignGcode, RefusesWhatItCannotMapNamingTheLine) {
+  const auto field = planar_field({});
+  const std::string head = "M82\nG28\n;LAYER_CHANGE\n;Z:0.2\n;HEIGHT:0.2\nG1 X1 Y1 E1\n";
+  auto arc = map_foreign_gcode(head + "G2 X5 Y5 I1 J1 E2\n", *field, {}, {});
+  ASSERT_FALSE(arc);
+  EXPECT_NE(arc.error().message.find("line 7: arc"), std::string::npos) << arc.error().message;
+  auto home = map_foreign_gcode(head + "G1 X2 Y2 E2\nG29\n", *field, {}, {});
+  ASSERT_FALSE(home);
+  EXPECT_NE(home.error().message.find("line 8"), std::string::npos) << home.error().message;
+  auto word = map_foreign_gcode(head + "G1 X2 Q4\n", *field, {}, {});
+  ASSERT_FALSE(word);
+  EXPECT_NE(word.error().message.find("line 7"), std::string::npos);
+  EXPECT_FALSE(map_foreign_gcode("G1 X1 Y1 E1\n", *field, {}, {}));  // no layers
+  // Start G-code before the first layer passes untouched, whatever it holds.
+  auto ok = map_foreign_gcode("M862.3 P \"MK3S\"\nG29 ; mesh\n" + head.substr(8) + "G92 E0\n",
+                              *field, {}, {});
+  ASSERT_TRUE(ok) << ok.error().message;
+  EXPECT_EQ(ok->text.rfind("M862.3 P \"MK3S\"\nG29 ; mesh\n", 0), 0u);
+  EXPECT_NE(ok->text.find("G1 X1.000 Y1.000 E1.00000"), std::string::npos) << ok->text;
+}
+
+}  // namespace
+}  // namespace nonplanar
