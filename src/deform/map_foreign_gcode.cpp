@@ -41,7 +41,7 @@ struct Move {
 // One input line: untouched text, or a move of the print (index into moves), or a layer's
 // ;Z: / ;HEIGHT: comment (rewritten).
 struct Item {
-  enum Kind { text, move, z_comment, height_comment, e_reset, e_mode } kind = text;
+  enum Kind { text, move, z_comment, height_comment, e_reset, e_mode, xyz_relative } kind = text;
   std::string_view raw;
   int index = -1;
   double value = 0;  ///< e_reset: the new E; e_mode: 1 relative, 0 absolute
@@ -145,6 +145,7 @@ Expected<ForeignGcode> map_foreign_gcode(std::string_view text, const LayerField
   bool rel_e = false, rel_xyz = false, wipe = false, rel_e_at_print = false;
   bool layer_header = false;  // between ;LAYER_CHANGE and the layer's ;HEIGHT:
   double e_at_end = 0, e_at_print = 0;
+  bool rel_e_at_end = false, rel_xyz_at_end = false;
   std::string type;
   int layer = -1;
   for (std::size_t i = 0; i < lines.size(); ++i) {
@@ -154,7 +155,7 @@ Expected<ForeignGcode> map_foreign_gcode(std::string_view text, const LayerField
     };
     const bool in_print = i >= first_layer && i < print_end;
     if (i == first_layer) rel_e_at_print = rel_e, e_at_print = e;
-    if (i == print_end) e_at_end = e;
+    if (i == print_end) e_at_end = e, rel_e_at_end = rel_e, rel_xyz_at_end = rel_xyz;
     std::string_view l = lines[i];
     Item item;
     item.raw = l;
@@ -191,7 +192,10 @@ Expected<ForeignGcode> map_foreign_gcode(std::string_view text, const LayerField
       rel_e = *num == 83;
       item.kind = Item::e_mode, item.value = rel_e;
     }
-    if (kind == 'G' && num && (*num == 90 || *num == 91)) rel_xyz = *num == 91;
+    if (kind == 'G' && num && (*num == 90 || *num == 91)) {
+      rel_xyz = *num == 91;
+      if (rel_xyz && in_print) item.kind = Item::xyz_relative;  // written absolute: see below
+    }
     if (kind == 'G' && num && *num == 92) {
       for (std::string_view w = tok.next(); !w.empty(); w = tok.next()) {
         const auto v = io::parse_double(w.substr(1));
@@ -253,7 +257,7 @@ Expected<ForeignGcode> map_foreign_gcode(std::string_view text, const LayerField
     }
     items.push_back(item);
   }
-  if (print_end == lines.size()) e_at_end = e;
+  if (print_end == lines.size()) e_at_end = e, rel_e_at_end = rel_e, rel_xyz_at_end = rel_xyz;
   if (ctx.cancelled()) return Error{Status::cancelled, "cancelled"};
 
   // Pass 2, a layer at a time: map its extrusions and wipes first (their highest point and
@@ -304,6 +308,11 @@ Expected<ForeignGcode> map_foreign_gcode(std::string_view text, const LayerField
     ExtrusionPath* run = nullptr;  // the gate's path being extended
     for (std::size_t k = i; k < j; ++k) {
       const Item& it = items[k];
+      if (it.kind == Item::xyz_relative) {
+        // Mapped moves are written absolute, so the printer stays in G90 through the print.
+        w.raw("; G91 (relative XYZ) applied by nonplanar: the mapped moves are absolute");
+        continue;
+      }
       if (it.kind == Item::text || it.kind == Item::e_reset || it.kind == Item::e_mode) {
         w.raw(it.raw);
         if (it.kind == Item::e_reset) w.set_e(it.value);
@@ -397,7 +406,8 @@ Expected<ForeignGcode> map_foreign_gcode(std::string_view text, const LayerField
     if (ctx.cancelled()) return Error{Status::cancelled, "cancelled"};
   }
   // The end G-code as written, after telling the firmware the file's own E (absolute E).
-  if (print_end < lines.size() && !rel_e_at_print) w.line("G92 E%.5f", e_at_end);
+  if (print_end < lines.size() && !rel_e_at_end) w.line("G92 E%.5f", e_at_end);
+  if (print_end < lines.size() && rel_xyz_at_end) w.raw("G91 ; as the file had it here");
   for (; i < lines.size(); ++i) w.raw(items[i].raw);
   out.text = std::move(w.out);
   return out;

@@ -100,6 +100,13 @@ TEST(MapForeignGcode, RefusesWhatItCannotMapNamingTheLine) {
   ASSERT_TRUE(ok) << ok.error().message;
   EXPECT_EQ(ok->text.rfind("M862.3 P \"MK3S\"\nG29 ; mesh\n", 0), 0u);
   EXPECT_NE(ok->text.find("G1 X1.000 Y1.000 E1.00000"), std::string::npos) << ok->text;
+  // Relative XYZ inside the print is applied here: the mapped moves are absolute (E follows
+  // M82/M83 only, as in the strict reader).
+  auto rel = map_foreign_gcode(head + "G91\nG1 X2 Y1 E1\nG90\nG1 X5 E2\n", *field, {}, {});
+  ASSERT_TRUE(rel) << rel.error().message;
+  EXPECT_NE(rel->text.find("G1 X3.000 Y2.000 E1.00000"), std::string::npos) << rel->text;
+  EXPECT_NE(rel->text.find("G1 X5.000 Y2.000 E2.00000"), std::string::npos) << rel->text;
+  EXPECT_EQ(rel->text.find("\nG91\n"), std::string::npos);
 }
 
 }  // namespace
