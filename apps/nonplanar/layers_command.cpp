@@ -107,6 +107,16 @@ int run(LayersOptions o) {
     for (const auto& f : plan->fallbacks) fb.push_back({{"patch", f.patch}, {"reason", f.reason}});
     j["planar_fallbacks"] = std::move(fb);
     if (!o.export_normalized.empty()) j["normalized_edges_split"] = split;
+    if (plan->stacks.empty()) {
+      const ShellSummary sh = summarize_shell(loaded->mesh, *analysis, o.layers);
+      if (!sh.patches.empty())
+        j["shell"] = {{"patches", sh.patches},
+                      {"layers", sh.layers},
+                      {"thickness", sh.thickness},
+                      {"core_layers", sh.core_layers}};
+      else
+        j["shell"] = {{"refused", sh.refused}};
+    }
     std::printf("%s\n", j.dump(2).c_str());
     return kExitOk;
   }
@@ -121,6 +131,18 @@ int run(LayersOptions o) {
         st.max_block_rise, st.cost_before, st.cost_after, st.iterations);
   for (const auto& f : plan->fallbacks)
     std::printf("  patch %d planar: %s\n", f.patch, f.reason.c_str());
+  if (plan->stacks.empty()) {
+    // What `slice` does then (it also runs the safety check on the result).
+    const ShellSummary sh = summarize_shell(loaded->mesh, *analysis, o.layers);
+    std::string list;
+    for (int p : sh.patches) list += (list.empty() ? "" : ", ") + std::to_string(p);
+    if (!sh.patches.empty())
+      std::printf(
+          "  shell: patch%s %s as %d curved layers of %.2f mm over %zu planar core layers\n",
+          sh.patches.size() == 1 ? "" : "es", list.c_str(), sh.layers, sh.thickness, sh.core_layers);
+    else
+      std::printf("  no shell: %s\n", sh.refused.c_str());
+  }
   return kExitOk;
 }
 

@@ -148,6 +148,17 @@ class LayerField {
 Expected<bool> write_section_svg(const std::filesystem::path& file, const TriangleMesh& mesh,
                                  const LayerPlan& plan, char axis, double value);
 
+/// What `slice` prints when plan_layers builds no stack but the part's whole top is curved: a
+/// shell of curved layers over a planar core (src/layers/shell_plan.hpp; README), or why not.
+struct ShellSummary {
+  std::vector<int> patches;  ///< the patches the shell follows; empty: no shell
+  int layers = 0;            ///< curved layers
+  double thickness = 0;      ///< of each, mm
+  std::size_t core_layers = 0;
+  std::string refused;  ///< why not (empty when there is a shell)
+};
+ShellSummary summarize_shell(const TriangleMesh& mesh, const Analysis& a, const LayerParams& p);
+
 /// A planar-only field (first layer h₁, then h).
 std::shared_ptr<const LayerField> planar_field(const LayerParams& params);
 

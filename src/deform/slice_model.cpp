@@ -269,15 +269,8 @@ Expected<std::optional<SliceResult>> try_shell(const TriangleMesh& mesh, const S
                                                const Context& ctx) {
   // All the patches that need curved layers, taken as one top (the CurviSlicer airfoil's top
   // is two, split at a crease); failing that, the largest alone.
-  std::vector<int> all;
-  for (std::size_t i = 0; i < analysis.patches.size(); ++i)
-    if (analysis.patches[i].needs_nonplanar()) all.push_back(static_cast<int>(i));
-  if (all.empty()) return std::optional<SliceResult>{};
-  layers::ShellPlan plan = layers::plan_shell(mesh, analysis, all, job.layers);
-  if (!plan.refused.empty() && all.size() > 1) {
-    layers::ShellPlan one = layers::plan_shell(mesh, analysis, {all.front()}, job.layers);
-    if (one.refused.empty()) plan = std::move(one);
-  }
+  const layers::ShellPlan plan = layers::choose_shell(mesh, analysis, job.layers);
+  if (plan.patches.empty()) return std::optional<SliceResult>{};
   std::string name = "patch";
   if (plan.patches.size() > 1) name += "es";
   for (std::size_t k = 0; k < plan.patches.size(); ++k)

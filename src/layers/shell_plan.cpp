@@ -146,4 +146,37 @@ ShellPlan plan_shell(const TriangleMesh& mesh, const Analysis& a, const std::vec
   return s;
 }
 
+ShellPlan choose_shell(const TriangleMesh& mesh, const Analysis& a, const LayerParams& p) {
+  std::vector<int> all;
+  for (std::size_t i = 0; i < a.patches.size(); ++i)
+    if (a.patches[i].needs_nonplanar()) all.push_back(static_cast<int>(i));
+  if (all.empty()) {
+    ShellPlan none;
+    none.refused = "no patch needs curved layers";
+    return none;
+  }
+  ShellPlan plan = plan_shell(mesh, a, all, p);
+  if (!plan.refused.empty() && all.size() > 1) {
+    ShellPlan one = plan_shell(mesh, a, {all.front()}, p);
+    if (one.refused.empty()) plan = std::move(one);
+  }
+  return plan;
+}
+
 }  // namespace nonplanar::layers
+
+namespace nonplanar {
+
+ShellSummary summarize_shell(const TriangleMesh& mesh, const Analysis& a, const LayerParams& p) {
+  const layers::ShellPlan plan = layers::choose_shell(mesh, a, p);
+  ShellSummary s;
+  s.refused = plan.refused;
+  if (!plan.refused.empty()) return s;
+  s.patches = plan.patches;
+  s.layers = plan.N;
+  s.thickness = plan.t;
+  s.core_layers = plan.core.size() - 1;
+  return s;
+}
+
+}  // namespace nonplanar

@@ -55,6 +55,11 @@ extern const char* const kNotOnTop;
 ShellPlan plan_shell(const TriangleMesh& mesh, const Analysis& a, const std::vector<int>& patches,
                      const LayerParams& p);
 
+/// The shell `slice` tries when no stack can be built: all the patches that need curved
+/// layers as one top, or failing that the largest alone (refused, with the first reason,
+/// when neither fits; patches empty when none needs curved layers).
+ShellPlan choose_shell(const TriangleMesh& mesh, const Analysis& a, const LayerParams& p);
+
 /// The shell's layer field: T = N + (z − H)/t, ζ = t·T, so the normalised mesh holds the
 /// shell's layers as planes ζ = j·t … (j + 1)·t. Every column is curved.
 class ShellField final : public LayerField {

@@ -122,6 +122,23 @@ TEST(Cli, LayersReportsStacksAndWritesTheirFiles) {
   EXPECT_EQ(run("layers --max-layer-height 0.05 " + (dir / "roof.stl").string()).code, 2);
 }
 
+// A part no stack can follow: `layers` says what `slice` prints instead, and `slice` does it.
+TEST(Cli, LayersAndSliceReportTheShell) {
+  const auto dir = test::temp_dir("cli_shell");
+  ASSERT_TRUE(write_stl(dir / "rib.stl", test::rib()));
+  const CliResult r = run("layers -q " + (dir / "rib.stl").string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("0 curved stacks"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("shell: patch 0 as 4 curved layers of 0.20 mm over"), std::string::npos)
+      << r.out;
+  const CliResult s =
+      run("slice " + (dir / "rib.stl").string() + " -o " + (dir / "r.gcode").string());
+  ASSERT_EQ(s.code, 0) << s.err;
+  EXPECT_NE(s.err.find("a curved shell of 4 layers"), std::string::npos) << s.err;
+  EXPECT_NE(test::read_bytes(dir / "r.gcode").find("; patch 0: a shell of 4 curved layers"),
+            std::string::npos);
+}
+
 TEST(Cli, SlicePlanarWritesGcodeAndRefusesBadSettings) {
   const auto dir = test::temp_dir("cli_slice");
   ASSERT_TRUE(write_stl(dir / "c.stl", test::box({0, 0, 0}, {20, 20, 10})));
