@@ -18,18 +18,10 @@ bool have_prusaslicer() {
   return std::system("command -v prusa-slicer >/dev/null 2>&1") == 0;
 }
 
-TriangleMesh placed(TriangleMesh m, const PrintConfig& c) {
-  const BoundingBox b = bounding_box(m);
-  const Vec3 shift(c.bed_center().x() - 0.5 * (b.min.x() + b.max.x()),
-                   c.bed_center().y() - 0.5 * (b.min.y() + b.max.y()), -b.min.z());
-  for (Vec3& v : m.vertices) v += shift;
-  return m;
-}
-
 TEST(EnginePrusaSlicer, SaddleMeetsTheBuiltInEnginesFigures) {
   if (!have_prusaslicer()) GTEST_SKIP() << "prusa-slicer not installed";
   PrintConfig c;
-  const TriangleMesh mesh = placed(test::saddle(), c);
+  const TriangleMesh mesh = test::placed(test::saddle(), c);
   SliceJob job = make_job(c);
   job.engine.engine = Engine::prusaslicer;
   auto r = slice_model(mesh, job, {});

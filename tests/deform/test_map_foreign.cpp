@@ -13,14 +13,6 @@
 namespace nonplanar {
 namespace {
 
-TriangleMesh placed(TriangleMesh m, const PrintConfig& c) {
-  const BoundingBox b = bounding_box(m);
-  const Vec3 shift(c.bed_center().x() - 0.5 * (b.min.x() + b.max.x()),
-                   c.bed_center().y() - 0.5 * (b.min.y() + b.max.y()), -b.min.z());
-  for (Vec3& v : m.vertices) v += shift;
-  return m;
-}
-
 CheckFigures figures(const std::string& gcode, const TriangleMesh& mesh) {
   auto moves = read_gcode_moves(gcode);
   EXPECT_TRUE(moves) << moves.error().message;
@@ -32,7 +24,7 @@ CheckFigures figures(const std::string& gcode, const TriangleMesh& mesh) {
 TEST(MapForeignGcode, PlanarFileOfTheNormalisedSaddlePrintsLikeTheBuiltInRoute) {
   PrintConfig c;
   c.paths.fill_density = 1.0;
-  const TriangleMesh mesh = placed(test::saddle(), c);
+  const TriangleMesh mesh = test::placed(test::saddle(), c);
   const SliceJob job = make_job(c);
   auto a = analyze(mesh, job.analysis, {});
   ASSERT_TRUE(a);

@@ -12,14 +12,6 @@
 namespace nonplanar {
 namespace {
 
-TriangleMesh placed(TriangleMesh m, const PrintConfig& c) {
-  const BoundingBox b = bounding_box(m);
-  const Vec3 shift(c.bed_center().x() - 0.5 * (b.min.x() + b.max.x()),
-                   c.bed_center().y() - 0.5 * (b.min.y() + b.max.y()), -b.min.z());
-  for (Vec3& v : m.vertices) v += shift;
-  return m;
-}
-
 struct Outcome {
   SliceResult result;
   CheckFigures figures;
@@ -27,7 +19,7 @@ struct Outcome {
 };
 
 Outcome run(const TriangleMesh& raw, PrintConfig c = {}) {
-  const TriangleMesh mesh = placed(raw, c);
+  const TriangleMesh mesh = test::placed(raw, c);
   auto r = slice_model(mesh, make_job(c), {});
   EXPECT_TRUE(r) << r.error().message;
   auto text = make_gcode(r->layers, c, r->header, {});

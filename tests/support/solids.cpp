@@ -43,6 +43,14 @@ TriangleMesh height_field_solid(const std::function<double(double, double)>& f, 
   return m;
 }
 
+TriangleMesh placed(TriangleMesh m, const PrintConfig& c) {
+  const BoundingBox b = bounding_box(m);
+  const Vec3 shift(c.bed_center().x() - 0.5 * (b.min.x() + b.max.x()),
+                   c.bed_center().y() - 0.5 * (b.min.y() + b.max.y()), -b.min.z());
+  for (Vec3& v : m.vertices) v += shift;
+  return m;
+}
+
 TriangleMesh box(const Vec3& lo, const Vec3& hi) {
   return height_field_solid([&](double, double) { return hi.z(); }, lo.x(), hi.x(), lo.y(), hi.y(),
                             1, 1, lo.z());

@@ -6,6 +6,7 @@
 #include <functional>
 #include <string>
 
+#include "nonplanar/config.hpp"
 #include "nonplanar/mesh.hpp"
 
 namespace nonplanar::test {
@@ -14,6 +15,10 @@ namespace nonplanar::test {
 /// bottom at z = base, vertical walls. Requires f > base.
 TriangleMesh height_field_solid(const std::function<double(double, double)>& f, double x0,
                                 double x1, double y0, double y1, int nx, int ny, double base = 0.0);
+
+/// m moved as the CLI places a part on c's bed: XY box centre at the bed's centre, lowest
+/// point at z = 0.
+TriangleMesh placed(TriangleMesh m, const PrintConfig& c);
 
 /// Axis-aligned box.
 TriangleMesh box(const Vec3& min, const Vec3& max);
