@@ -106,6 +106,127 @@ class Writer {
   double e_ = 0;
 };
 
+// Top skins on a slope, low to high (DESIGN.md §3: a line printed beside a higher line of the
+// same layer drags the nozzle's flat through it). In each run of "Top solid infill" of `seq`
+// (one layer), the strokes (unbroken extrusions) are sorted by mean mapped height and each
+// starts at its low end; the travels between them are made anew, with the run's own
+// retraction around them and its extrusion feed rate after. The run's trailing wipes become
+// plain retractions (their path retraced the old last stroke). New and reversed moves are
+// appended to `moves` and `mapped`.
+void order_top_skins(std::vector<Item>& seq, std::vector<Move>& moves,
+                     std::vector<ExtrusionPath>& mapped) {
+  auto is_type = [](const Item& it, std::string_view t) {
+    return it.kind == Item::text && it.raw.rfind(t, 0) == 0;
+  };
+  auto mean_z = [&](const std::vector<int>& stroke) {
+    double z = 0;
+    std::size_t n = 0;
+    for (int m : stroke)
+      for (const Vec3& v : mapped[static_cast<std::size_t>(m)].points) z += v.z(), ++n;
+    return n ? z / static_cast<double>(n) : 0.0;
+  };
+  auto add = [&](Move m, ExtrusionPath p) {
+    moves.push_back(std::move(m));
+    mapped.push_back(std::move(p));
+    Item it;
+    it.kind = Item::move;
+    it.index = static_cast<int>(moves.size()) - 1;
+    return it;
+  };
+  for (std::size_t s = 0; s < seq.size(); ++s) {
+    if (!is_type(seq[s], ";TYPE:Top solid infill")) continue;
+    std::size_t e = s + 1;
+    while (e < seq.size() && !is_type(seq[e], ";TYPE:")) ++e;
+    std::vector<std::vector<int>> strokes;
+    std::vector<Item> head, tail;  // the run's other lines; what follows its last stroke
+    double ret = 0, ret_f = kNone, unret_f = kNone, travel_f = kNone, print_f = kNone;
+    bool in_stroke = false;
+    std::size_t last = s;
+    for (std::size_t k = s + 1; k < e; ++k)
+      if (seq[k].kind == Item::move && moves[static_cast<std::size_t>(seq[k].index)].extruding())
+        last = k;
+    for (std::size_t k = s + 1; k < e; ++k) {
+      const Item& it = seq[k];
+      if (k > last) {
+        if (it.kind != Item::move) {
+          tail.push_back(it);
+          continue;
+        }
+        Move m = moves[static_cast<std::size_t>(it.index)];
+        if (m.wipe && m.has_xy) {  // a wipe: its retraction, in place
+          m.has_xy = false, m.to = m.from;
+          tail.push_back(add(std::move(m), {}));
+        } else {
+          tail.push_back(it);
+        }
+        continue;
+      }
+      if (it.kind != Item::move) {
+        if (it.kind != Item::e_reset) head.push_back(it);  // E is ours inside the run
+        continue;
+      }
+      const Move& m = moves[static_cast<std::size_t>(it.index)];
+      if (m.extruding()) {
+        if (!in_stroke) strokes.emplace_back();
+        strokes.back().push_back(it.index);
+        in_stroke = true;
+        continue;
+      }
+      in_stroke = false;
+      const bool e_only = !m.has_xy && !m.has_z;
+      if (e_only && m.has_e && m.de < 0 && ret == 0) ret = -m.de, ret_f = m.f;
+      if (e_only && m.has_e && m.de > 0 && std::isnan(unret_f)) unret_f = m.f;
+      if (e_only && !m.has_e && !std::isnan(m.f) && strokes.empty()) print_f = m.f;
+      if (m.has_xy && !m.has_e && std::isnan(travel_f)) travel_f = m.f;
+    }
+    if (strokes.empty()) continue;
+    std::stable_sort(strokes.begin(), strokes.end(),
+                     [&](const auto& a, const auto& b) { return mean_z(a) < mean_z(b); });
+    std::vector<Item> out{seq[s]};
+    out.insert(out.end(), head.begin(), head.end());
+    const Move& first = moves[static_cast<std::size_t>(strokes.front().front())];
+    Vec3 prev = first.from;
+    for (const auto& stroke : strokes) {
+      const ExtrusionPath& a = mapped[static_cast<std::size_t>(stroke.front())];
+      const ExtrusionPath& b = mapped[static_cast<std::size_t>(stroke.back())];
+      const bool reverse = a.points.front().z() > b.points.back().z() + 1e-9;
+      const Move& m0 = moves[static_cast<std::size_t>(reverse ? stroke.back() : stroke.front())];
+      const Vec3 start = reverse ? m0.to : m0.from;
+      Move travel = m0;
+      travel.from = prev, travel.to = start, travel.has_xy = true, travel.has_z = false;
+      travel.has_e = false, travel.de = 0, travel.wipe = false, travel.f = travel_f;
+      Move r = travel;
+      r.has_xy = false, r.from = r.to = prev, r.has_e = true, r.de = -ret, r.f = ret_f;
+      const bool hop = ret > 0 && (start - prev).head<2>().norm() > 1.0;
+      if (hop) out.push_back(add(r, {}));
+      out.push_back(add(travel, {}));
+      if (hop) {
+        r.from = r.to = start, r.de = ret, r.f = unret_f;
+        out.push_back(add(r, {}));
+      }
+      bool first_piece = true;
+      for (std::size_t q = 0; q < stroke.size(); ++q) {
+        const int idx = stroke[reverse ? stroke.size() - 1 - q : q];
+        Move m = moves[static_cast<std::size_t>(idx)];
+        ExtrusionPath p = mapped[static_cast<std::size_t>(idx)];
+        if (reverse) {
+          std::swap(m.from, m.to);
+          std::reverse(p.points.begin(), p.points.end());
+          std::reverse(p.height.begin(), p.height.end());
+        }
+        if (first_piece && std::isnan(m.f)) m.f = print_f;
+        first_piece = false;
+        prev = m.to;
+        out.push_back(add(std::move(m), std::move(p)));
+      }
+    }
+    out.insert(out.end(), tail.begin(), tail.end());
+    seq.erase(seq.begin() + static_cast<long>(s), seq.begin() + static_cast<long>(e));
+    seq.insert(seq.begin() + static_cast<long>(s), out.begin(), out.end());
+    s += out.size() - 1;
+  }
+}
+
 }  // namespace
 
 Expected<ForeignGcode> map_foreign_gcode(std::string_view text, const LayerField& field,
@@ -302,12 +423,14 @@ Expected<ForeignGcode> map_foreign_gcode(std::string_view text, const LayerField
       }
     }
     if (L.max_z < -1e299) L.max_z = 0;
+    std::vector<Item> seq(items.begin() + static_cast<long>(i),
+                          items.begin() + static_cast<long>(j));
+    order_top_skins(seq, moves, mapped);
     // Write.
     double h_sum = 0;
     std::size_t h_n = 0;
     ExtrusionPath* run = nullptr;  // the gate's path being extended
-    for (std::size_t k = i; k < j; ++k) {
-      const Item& it = items[k];
+    for (const Item& it : seq) {
       if (it.kind == Item::xyz_relative) {
         // Mapped moves are written absolute, so the printer stays in G90 through the print.
         w.raw("; G91 (relative XYZ) applied by nonplanar: the mapped moves are absolute");

@@ -53,6 +53,37 @@ TEST(MapForeignGcode, PlanarFileOfTheNormalisedSaddlePrintsLikeTheBuiltInRoute) 
   EXPECT_GE(f.thickness_min, job.layers.min_layer_height - 1e-3);
   EXPECT_LE(f.thickness_max, job.layers.max_layer_height + 1e-3);
   EXPECT_NEAR(f.volume_ratio, 1.0, 0.03);
+  // Top skins low to high (DESIGN.md §3): in each layer's top-skin run, every stroke
+  // starts at its low end and no stroke lies lower than the one before it.
+  auto moves = read_gcode_moves(mapped->text);
+  ASSERT_TRUE(moves);
+  std::size_t strokes = 0;
+  int layer = -2;
+  double prev_mean = -1e9;
+  std::vector<Vec3> stroke;
+  auto close = [&] {
+    if (stroke.empty()) return;
+    double z = 0;
+    for (const Vec3& v : stroke) z += v.z();
+    z /= static_cast<double>(stroke.size());
+    EXPECT_LE(stroke.front().z(), stroke.back().z() + 2e-3) << "layer " << layer;
+    EXPECT_GE(z, prev_mean - 2e-3) << "layer " << layer;  // µm rounding of the file
+    prev_mean = z, ++strokes;
+    stroke.clear();
+  };
+  for (const PrintMove& m : *moves) {
+    if (m.layer != layer || m.type != "Top solid infill") close();
+    if (m.layer != layer) layer = m.layer, prev_mean = -1e9;
+    if (m.type != "Top solid infill") continue;
+    if (!m.extruding) {
+      if ((m.to - m.from).head<2>().norm() > 1e-9) close();
+      continue;
+    }
+    if (stroke.empty()) stroke.push_back(m.from);
+    stroke.push_back(m.to);
+  }
+  close();
+  EXPECT_GT(strokes, 20u);
   // The built-in route on the same part, for comparison: the same layers, so nearly the same
   // volume and deviation.
   auto builtin = slice_model(mesh, job, {});
