@@ -23,7 +23,7 @@ common=(--layer-height 0.2 --first-layer-height 0.2 --perimeters 2 --top-solid-l
         --bottom-solid-layers 4 --fill-density 20% --fill-pattern rectilinear --skirts 1
         --nozzle-diameter 0.4 --filament-diameter 1.75 --temperature 210 --bed-temperature 60)
 # One row per slicer: deviation p95 / mean / max (mm), thickness min-max (mm), steepest (deg),
-# collisions; nonplanar's row also says how many curved stacks it printed.
+# collisions; nonplanar's row also says how many curved stacks (or shells) it printed.
 figures() {
   ./build/nonplanar check -q --json "$1" --mesh "$2" | python3 -c '
 import json, sys
@@ -33,11 +33,11 @@ print("%7.4f %7.4f %7.4f  %5.3f-%5.3f %6.1f %6d" % (d["p95"], d["mean"], d["max"
       j["thickness_min"], j["thickness_max"], j["steepest_extrusion"], j["collisions"]))'
 }
 printf "%-34s %-11s %7s %7s %7s  %-11s %6s %6s  %s\n" model slicer p95 mean max thickness steep coll \
-  "curved stacks"
+  "curved stacks/shells"
 for m in "${models[@]}"; do
   name=$(basename "$m")
   ./build/nonplanar slice -q "$m" -o "$tmp/np.gcode" "${common[@]}"
-  stacks=$(grep -c '^; patch .* curved layers' "$tmp/np.gcode" || true)
+  stacks=$(grep -cE '^; patch(es)? .*curved layers' "$tmp/np.gcode" || true)
   prusa-slicer --export-gcode "${common[@]}" --gcode-flavor marlin2 \
     --bed-shape 0x0,220x0,220x220,0x220 --center 110,110 -o "$tmp/ps.gcode" "$m" >/dev/null 2>&1
   printf "%-34s %-11s %s  %s\n" "$name" nonplanar "$(figures "$tmp/np.gcode" "$m")" "$stacks"
