@@ -139,7 +139,8 @@ int run(LayersOptions o) {
     if (!sh.patches.empty())
       std::printf(
           "  shell: patch%s %s as %d curved layers of %.2f mm over %zu planar core layers\n",
-          sh.patches.size() == 1 ? "" : "es", list.c_str(), sh.layers, sh.thickness, sh.core_layers);
+          sh.patches.size() == 1 ? "" : "es", list.c_str(), sh.layers, sh.thickness,
+          sh.core_layers);
     else
       std::printf("  no shell: %s\n", sh.refused.c_str());
   }
