@@ -8,7 +8,7 @@
 // thickness against the planar ones (L·t / (L_p·h)); a wipe follows the layer with its E
 // spread over the pieces; a travel over curved layers rises above the layer's highest point
 // (or, for a hop under 0.6 mm, its slope's reach) and comes down at the target, as the
-// built-in writer does.
+// built-in writer does; top skins are re-ordered low to high (order_top_skins).
 #include <algorithm>
 #include <cctype>
 #include <cmath>
