@@ -74,8 +74,8 @@ class Writer {
     va_end(ap);
     raw(buf);
   }
-  // A move to p (mapped) pushing de of filament; F only where the input had it.
-  // E and F are written only where given (NaN: not given).
+  // A move from `from` to p (mapped) pushing e mm of filament at feed rate f; only the axes
+  // that change are written, E and F only where given (NaN: not given).
   void move(const Vec3& p, const Vec3& from, double e, double f) {
     std::string s = "G1";
     char buf[64];

@@ -334,16 +334,12 @@ Expected<SliceResult> slice_model(const TriangleMesh& mesh, const SliceJob& job,
   std::vector<std::string> dropped;
   std::vector<std::pair<int, std::string>> offenders;
   for (int round = 0; round < 8; ++round) {
+    // The external engine prints no shells (yet): with it, a part without stacks slices
+    // planar at once.
     bool deferred = false;
-    auto r = attempt(mesh, job, pre, excluded, &offenders, &deferred, ctx);
+    auto r = attempt(mesh, job, pre, excluded, &offenders,
+                     job.engine.engine == Engine::builtin ? &deferred : nullptr, ctx);
     if (!r) return r;
-    if (deferred && job.engine.engine != Engine::builtin) {
-      // The external engine prints no shells (yet): planar, with its notices.
-      r = attempt(mesh, job, pre, excluded, &offenders, nullptr, ctx);
-      if (!r) return r;
-      r->notices.insert(r->notices.begin(), dropped.begin(), dropped.end());
-      return r;
-    }
     if (deferred) {
       // No curved stack: a shell, or else the same attempt sliced planar (its stacks cached).
       r->notices.insert(r->notices.begin(), dropped.begin(), dropped.end());

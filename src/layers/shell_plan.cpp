@@ -57,14 +57,13 @@ ShellPlan plan_shell(const TriangleMesh& mesh, const Analysis& a, const std::vec
                      const LayerParams& p) {
   ShellPlan s;
   s.patches = patches;
-  // The patches as one: their facets, box and height range.
+  // The patches as one: their facets, box and height range (what faceted_top reads).
   Patch P;
   P.xy_min = Vec2::Constant(1e300), P.xy_max = Vec2::Constant(-1e300);
   P.z_min = 1e300, P.z_max = -1e300;
   for (int i : patches) {
     const Patch& q = a.patches[static_cast<std::size_t>(i)];
     P.faces.insert(P.faces.end(), q.faces.begin(), q.faces.end());
-    P.area += q.area;
     P.xy_min = P.xy_min.cwiseMin(q.xy_min), P.xy_max = P.xy_max.cwiseMax(q.xy_max);
     P.z_min = std::min(P.z_min, q.z_min), P.z_max = std::max(P.z_max, q.z_max);
   }

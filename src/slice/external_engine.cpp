@@ -85,7 +85,7 @@ Expected<std::string> run_engine(const EngineParams& e, const TriangleMesh& mesh
   if (!orca) {
     // Keys an older PrusaSlicer does not know (arc_fitting, 2.6+) are ignored in a loaded
     // file but fatal on the command line, so they go in a file loaded last.
-    std::ofstream(forced) << "arc_fitting = disabled\nspiral_vase = 0\nretract_lift = 0\n";
+    std::ofstream(forced) << "arc_fitting = disabled\n";
     args.push_back("--export-gcode");
     if (!e.config.empty()) args.insert(args.end(), {"--load", e.config});
     args.insert(args.end(),
