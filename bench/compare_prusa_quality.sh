@@ -23,7 +23,8 @@ common=(--layer-height 0.2 --first-layer-height 0.2 --perimeters 2 --top-solid-l
         --bottom-solid-layers 4 --fill-density 20% --fill-pattern rectilinear --skirts 1
         --nozzle-diameter 0.4 --filament-diameter 1.75 --temperature 210 --bed-temperature 60)
 # One row per slicer: deviation p95 / mean / max (mm), thickness min-max (mm), steepest (deg),
-# collisions; nonplanar's row also says how many curved stacks (or shells) it printed.
+# collisions; nonplanar's rows also say how many curved stacks (or shells) it printed: with its
+# built-in planar engine, and with PrusaSlicer as the engine (--engine prusaslicer).
 figures() {
   ./build/nonplanar check -q --json "$1" --mesh "$2" | python3 -c '
 import json, sys
@@ -38,8 +39,11 @@ for m in "${models[@]}"; do
   name=$(basename "$m")
   ./build/nonplanar slice -q "$m" -o "$tmp/np.gcode" "${common[@]}"
   stacks=$(grep -cE '^; patch(es)? .*curved layers' "$tmp/np.gcode" || true)
+  ./build/nonplanar slice -q "$m" -o "$tmp/np_ps.gcode" --engine prusaslicer "${common[@]}"
+  stacks_ps=$(grep -cE '^; patch(es)? .*curved layers' "$tmp/np_ps.gcode" || true)
   prusa-slicer --export-gcode "${common[@]}" --gcode-flavor marlin2 \
     --bed-shape 0x0,220x0,220x220,0x220 --center 110,110 -o "$tmp/ps.gcode" "$m" >/dev/null 2>&1
   printf "%-34s %-11s %s  %s\n" "$name" nonplanar "$(figures "$tmp/np.gcode" "$m")" "$stacks"
+  printf "%-34s %-11s %s  %s\n" "" np+engine "$(figures "$tmp/np_ps.gcode" "$m")" "$stacks_ps"
   printf "%-34s %-11s %s\n" "" PrusaSlicer "$(figures "$tmp/ps.gcode" "$m")"
 done

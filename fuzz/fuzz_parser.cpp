@@ -25,6 +25,15 @@ struct Wave final : nonplanar::LayerField {
   double thickness(double x, double, double) const override { return k(x); }
   bool planar_at(double, double) const override { return false; }
 };
+// The shell's core cut back: kept on a wavy region up to z = 5, nothing above z = 10.
+struct Waves final : nonplanar::LayerClip {
+  Cover cover(double z) const override {
+    return z < 2 ? Cover::all : z > 10 ? Cover::none : Cover::some;
+  }
+  double margin(double x, double y, double z) const override {
+    return std::sin(x / 3) + std::cos(y / 4) - 0.2 * z;
+  }
+};
 }  // namespace
 #endif
 
@@ -51,6 +60,12 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
 #elif NONPLANAR_FUZZ_PARSER == 8
   static const Wave field;
   (void)map_foreign_gcode(in, field, {}, {});
+  static const Waves clip;
+  ForeignMapOptions o;
+  o.clip = &clip;
+  o.start = Vec3(100, 100, 3);
+  o.start_retracted = 0.8;
+  (void)map_foreign_gcode(in, field, {}, {}, o);
 #else
 #error "NONPLANAR_FUZZ_PARSER must name a parser (0-8)"
 #endif

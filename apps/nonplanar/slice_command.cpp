@@ -132,7 +132,8 @@ void register_slice(CLI::App& app, std::function<int()>* run_fn) {
   cmd->add_flag("--planar", o->planar, "Planar layers only (the ordinary slicing engine)");
   cmd->add_option("--engine", o->engine,
                   "Planar engine for the normalised mesh: builtin, prusaslicer (PrusaSlicer 2.5+\n"
-                  "command line) or orcaslicer (untested); its G-code is mapped back")
+                  "command line; a shell over a planar core takes two runs, stitched) or\n"
+                  "orcaslicer (untested; no shells); its G-code is mapped back")
       ->capture_default_str();
   cmd->add_option("--engine-path", o->engine_path,
                   "The engine's executable (default: prusa-slicer / orca-slicer on PATH)");

@@ -2,6 +2,7 @@
 // layers become planar, (x, y, z) ↦ (x, y, ζ(T(x, y, z))), subdividing where the map bends.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <string_view>
 
@@ -40,6 +41,41 @@ Expected<std::vector<LayerToolpaths>> map_toolpaths_back(const std::vector<Layer
 struct ForeignGcode {
   std::string text;
   std::vector<LayerToolpaths> layers;  ///< one per ;LAYER_CHANGE of the print
+  /// Where in `text` the print starts (its first ;LAYER_CHANGE) and where the end G-code
+  /// starts (the E reset before it included), bytes.
+  std::size_t print_begin = 0, print_end = 0;
+  bool relative_e_at_print = false, relative_e_at_end = false;
+  double e_at_print = 0;     ///< the file's E when the print starts (absolute E), mm
+  std::string fan_at_print;  ///< the start G-code's last M106/M107 line (empty: none)
+  Vec3 end_at{0, 0, 0};      ///< the nozzle when the print ends, mapped, mm
+  /// Filament the print's own retractions leave pulled back when it ends (its start G-code's
+  /// state not counted), mm.
+  double retracted = 0;
+};
+
+/// A planar file's layers cut back to part of the plane: the shell's core (layers/shell_plan.hpp)
+/// when another slicer prints it.
+class LayerClip {
+ public:
+  enum class Cover { all, none, some };
+  virtual ~LayerClip() = default;
+  /// For the planar layer whose top is z (mm): keep all of it, none, or where margin >= 0.
+  virtual Cover cover(double z) const = 0;
+  /// Continuous in x, y; >= 0 where the layer with top z is kept (mm).
+  virtual double margin(double x, double y, double z) const = 0;
+};
+
+struct ForeignMapOptions {
+  /// Extrusions kept only where it says (the rest become travels; a layer with none kept is
+  /// left out but for its M-codes). Null: keep everything.
+  const LayerClip* clip = nullptr;
+  /// Where the nozzle really is when the print starts (mapped, mm), when another program ran
+  /// before this one's print: moves are written from there, not from where its start G-code
+  /// left it.
+  std::optional<Vec3> start;
+  /// Filament already pulled back when the print starts (mm): given back with the first
+  /// retraction move or before the first extrusion.
+  double start_retracted = 0;
 };
 
 /// Maps a planar G-code file (PrusaSlicer's or OrcaSlicer's, or ours) sliced from the
@@ -53,7 +89,8 @@ struct ForeignGcode {
 /// Errors (parse_error, naming the line): an arc, an unknown command or word inside the
 /// print, a move before the first layer, a file without ;LAYER_CHANGE.
 Expected<ForeignGcode> map_foreign_gcode(std::string_view text, const LayerField& field,
-                                         const MapBackParams& params, const Context& ctx);
+                                         const MapBackParams& params, const Context& ctx,
+                                         const ForeignMapOptions& options = {});
 
 /// Splits every edge whose mapped midpoint is farther than the tolerance from the mapped
 /// chord (conforming: both faces of an edge split it), then maps every vertex. A closed,

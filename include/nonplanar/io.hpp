@@ -47,8 +47,16 @@ Expected<LoadedMesh> load_mesh(const std::filesystem::path& file, const LoadPara
 /// Binary STL writer (used by tests, benchmarks and later stages). Atomic.
 Expected<bool> write_stl(const std::filesystem::path& file, const TriangleMesh& mesh);
 
-/// 3MF writer: one mesh object, one build item with no transform. Atomic.
-Expected<bool> write_3mf(const std::filesystem::path& file, const TriangleMesh& mesh);
+/// A file stored beside the model in a 3MF package: its path in the package ("/Metadata/…")
+/// and its bytes.
+struct PackageFile {
+  std::string path, content;
+};
+
+/// 3MF writer: one mesh object, one build item with no transform, and `extra` files (e.g.
+/// PrusaSlicer's layer-height profile). Atomic.
+Expected<bool> write_3mf(const std::filesystem::path& file, const TriangleMesh& mesh,
+                         const std::vector<PackageFile>& extra = {});
 
 /// ASCII PLY with one RGB colour per face (face_colors: F entries, 0xRRGGBB). Atomic.
 Expected<bool> write_ply_face_colors(const std::filesystem::path& file, const TriangleMesh& mesh,

@@ -31,7 +31,8 @@ struct Move {
   Vec3 from, to;  ///< planar
   double de = 0;  ///< filament pushed (negative: retraction)
   bool has_xy = false, has_z = false, has_e = false;
-  double f = kNone;  ///< feed rate, if the line had one
+  double f = kNone;     ///< feed rate, if the line had one
+  double feed = kNone;  ///< the feed rate in force for it (its own or the last one given)
   bool wipe = false;
   std::string type;
   double width = 0.45, h = 0.2;  ///< ;WIDTH: and the planar layer's ;HEIGHT:
@@ -227,10 +228,97 @@ void order_top_skins(std::vector<Item>& seq, std::vector<Move>& moves,
   }
 }
 
+// The file's first retraction inside the print: how far and how fast, and how fast it is given
+// back (none: length 0).
+struct Retraction {
+  double length = 0, f = kNone, back_f = kNone;
+};
+
+// Cuts each extrusion of one layer (`seq`) to where clip.margin(·, ·, z) >= 0: kept pieces
+// extrude their share of E, the rest become travels, retracted around when longer than 2 mm
+// (as PrusaSlicer's retract_before_travel). Crossings are found on 0.05 mm steps and bisected.
+// New moves are appended to `moves` and `mapped`. `samples` counts the margins looked up; past
+// 50 million (a broken file, not a print) it stops and returns the line it was on (else 0).
+int clip_layer(std::vector<Item>& seq, std::vector<Move>& moves, std::vector<ExtrusionPath>& mapped,
+               const LayerClip& clip, double z, const Retraction& ret, std::size_t& samples) {
+  auto add = [&](Move m, std::vector<Item>& out) {
+    moves.push_back(std::move(m));
+    mapped.emplace_back();
+    Item it;
+    it.kind = Item::move;
+    it.index = static_cast<int>(moves.size()) - 1;
+    out.push_back(it);
+  };
+  std::vector<Item> out;
+  out.reserve(seq.size());
+  for (const Item& it : seq) {
+    if (it.kind != Item::move || !moves[static_cast<std::size_t>(it.index)].extruding()) {
+      out.push_back(it);
+      continue;
+    }
+    const Move m = moves[static_cast<std::size_t>(it.index)];
+    auto at = [&](double s) { return Vec3(m.from + s * (m.to - m.from)); };
+    auto g = [&](double s) {
+      const Vec3 p = at(s);
+      return clip.margin(p.x(), p.y(), z);
+    };
+    // Pieces [s_k, s_k+1] between the crossings, each kept or not.
+    const double len = (m.to - m.from).head<2>().norm();
+    const int n = std::max(1, static_cast<int>(std::ceil(len / 0.05)));
+    samples += static_cast<std::size_t>(n) + 1;
+    if (samples > 50'000'000) return m.line;
+    std::vector<double> cuts{0.0};
+    double s0 = 0, g0 = g(0);
+    for (int k = 1; k <= n; ++k) {
+      const double s1 = static_cast<double>(k) / n, g1 = g(s1);
+      if ((g0 >= 0) != (g1 >= 0)) {
+        double lo = s0, hi = s1;
+        for (int b = 0; b < 30; ++b) {
+          const double mid = 0.5 * (lo + hi);
+          ((g(mid) >= 0) == (g0 >= 0) ? lo : hi) = mid;
+        }
+        cuts.push_back(0.5 * (lo + hi));
+      }
+      s0 = s1, g0 = g1;
+    }
+    cuts.push_back(1.0);
+    if (cuts.size() == 2 && g(0.5) >= 0) {
+      out.push_back(it);
+      continue;
+    }
+    bool retracted = false;
+    for (std::size_t k = 0; k + 1 < cuts.size(); ++k) {
+      Move piece = m;
+      piece.from = at(cuts[k]), piece.to = at(cuts[k + 1]);
+      piece.f = k == 0 ? m.f : retracted ? m.feed : kNone;
+      retracted = false;
+      if (g(0.5 * (cuts[k] + cuts[k + 1])) >= 0) {
+        piece.de = m.de * (cuts[k + 1] - cuts[k]);
+        add(piece, out);
+        continue;
+      }
+      piece.de = 0, piece.has_e = false;
+      const bool hop = ret.length > 0 && (piece.to - piece.from).head<2>().norm() > 2.0;
+      Move r = piece;
+      r.has_xy = false, r.has_e = true, r.to = r.from, r.de = -ret.length, r.f = ret.f;
+      if (hop) add(r, out), piece.f = m.feed;
+      add(piece, out);
+      if (hop) {
+        r.from = r.to = piece.to, r.de = ret.length, r.f = ret.back_f;
+        add(r, out);
+        retracted = true;
+      }
+    }
+  }
+  seq = std::move(out);
+  return 0;
+}
+
 }  // namespace
 
 Expected<ForeignGcode> map_foreign_gcode(std::string_view text, const LayerField& field,
-                                         const MapBackParams& params, const Context& ctx) {
+                                         const MapBackParams& params, const Context& ctx,
+                                         const ForeignMapOptions& options) {
   if (!(params.tolerance > 0)) return Error{Status::invalid_argument, "map tolerance: must be > 0"};
   // Split into lines; find where the print ends: the first ;TYPE:Custom after the last other
   // ;TYPE: (PrusaSlicer's and OrcaSlicer's end G-code follow one), else the end of the file.
@@ -261,6 +349,10 @@ Expected<ForeignGcode> map_foreign_gcode(std::string_view text, const LayerField
   std::vector<Move> moves;
   std::vector<Item> items;
   std::vector<double> layer_h;  // planar ;HEIGHT: per layer
+  std::vector<double> layer_z;  // planar ;Z: per layer (its top)
+  Retraction retraction;
+  std::string fan_at_print;
+  double feed = kNone;
   Vec3 pos(0, 0, 0);
   double e = 0, width = 0.45, h = 0.2;
   bool rel_e = false, rel_xyz = false, wipe = false, rel_e_at_print = false;
@@ -290,7 +382,8 @@ Expected<ForeignGcode> map_foreign_gcode(std::string_view text, const LayerField
       if (c.rfind(";WIPE_START", 0) == 0) wipe = true;
       if (c.rfind(";WIPE_END", 0) == 0) wipe = false;
       if (in_print && c.rfind(";LAYER_CHANGE", 0) == 0)
-        item.layer = ++layer, layer_h.push_back(h), layer_header = true;
+        item.layer = ++layer, layer_h.push_back(h), layer_z.push_back(pos.z() + h),
+        layer_header = true;
       // The layer's thickness is the ;HEIGHT: of its header; later ones are a bead's (a
       // bridge's is the nozzle's diameter) and pass untouched.
       if (in_print && layer_header && c.rfind(";HEIGHT:", 0) == 0 && semi == 0) {
@@ -298,7 +391,11 @@ Expected<ForeignGcode> map_foreign_gcode(std::string_view text, const LayerField
         item.kind = Item::height_comment;
         layer_header = false;
       }
-      if (in_print && c.rfind(";Z:", 0) == 0 && semi == 0) item.kind = Item::z_comment;
+      if (in_print && c.rfind(";Z:", 0) == 0 && semi == 0) {
+        item.kind = Item::z_comment;
+        if (auto v = io::parse_double(c.substr(3)); v && layer >= 0)
+          layer_z[static_cast<std::size_t>(layer)] = *v;
+      }
       l = l.substr(0, semi);
     }
     io::Tokenizer tok(l);
@@ -309,6 +406,8 @@ Expected<ForeignGcode> map_foreign_gcode(std::string_view text, const LayerField
     }
     const char kind = static_cast<char>(std::toupper(static_cast<unsigned char>(cmd[0])));
     const auto num = io::parse_int(cmd.substr(1));
+    const bool fan = kind == 'M' && num && (*num == 106 || *num == 107);
+    if (fan && i < first_layer) fan_at_print = std::string(lines[i]);
     if (kind == 'M' && num && (*num == 82 || *num == 83)) {
       rel_e = *num == 83;
       item.kind = Item::e_mode, item.value = rel_e;
@@ -358,6 +457,12 @@ Expected<ForeignGcode> map_foreign_gcode(std::string_view text, const LayerField
       if (in_print && m.to.cwiseAbs().maxCoeff() > 1e4)
         return fail("coordinate beyond 10 m: not a print this can map");
       pos = m.to;
+      if (!std::isnan(m.f)) feed = m.f;
+      m.feed = feed;
+      if (in_print && !m.has_xy && !m.has_z && m.has_e) {
+        if (m.de < 0 && retraction.length == 0) retraction.length = -m.de, retraction.f = m.f;
+        if (m.de > 0 && std::isnan(retraction.back_f)) retraction.back_f = m.f;
+      }
       if (in_print) {
         if (layer < 0) return fail("a move before the first layer");
         m.wipe = wipe, m.type = type, m.width = width, m.h = h;
@@ -391,20 +496,51 @@ Expected<ForeignGcode> map_foreign_gcode(std::string_view text, const LayerField
   std::size_t points = 0;
   std::size_t i = 0;
   for (; i < first_layer; ++i) w.raw(items[i].raw);
+  out.print_begin = w.out.size();
+  out.relative_e_at_print = rel_e_at_print, out.e_at_print = e_at_print;
+  out.fan_at_print = fan_at_print;
   if (!moves.empty()) at = moves.front().from;
+  if (options.start) at = *options.start;
+  double pending = options.start_retracted;  // given back at the first E move
+  double retracted = 0;
+  std::vector<char> dropped(layer_h.size(), 0);
+  std::size_t clip_samples = 0;
   w.set_e(e_at_print);  // absolute E continues from the untouched start G-code
   while (i < print_end) {
     std::size_t j = i + 1;
     while (j < print_end && items[j].raw.rfind(";LAYER_CHANGE", 0) != 0) ++j;
     const int li = items[i].layer;
-    LayerToolpaths& L = out.layers[static_cast<std::size_t>(std::max(li, 0))];
+    const std::size_t lu = static_cast<std::size_t>(std::max(li, 0));
+    LayerToolpaths& L = out.layers[lu];
     L.max_z = -1e300;
+    std::vector<Item> seq(items.begin() + static_cast<long>(i),
+                          items.begin() + static_cast<long>(j));
+    const auto cover = options.clip ? options.clip->cover(layer_z[lu]) : LayerClip::Cover::all;
+    if (cover == LayerClip::Cover::none) {
+      // Left out, but for what it tells the printer (temperatures, E mode); not the fan, which
+      // follows the layers printed instead (and is turned off at the end).
+      for (const Item& it : seq)
+        if (it.kind == Item::text || it.kind == Item::e_mode)
+          if (!it.raw.empty() && std::toupper(static_cast<unsigned char>(it.raw[0])) == 'M' &&
+              it.raw.rfind("M106", 0) != 0 && it.raw.rfind("M107", 0) != 0) {
+            w.raw(it.raw);
+            if (it.kind == Item::e_mode) w.set_relative(it.value != 0);
+          }
+      dropped[lu] = 1;
+      i = j;
+      continue;
+    }
+    if (cover == LayerClip::Cover::some)
+      if (const int bad =
+              clip_layer(seq, moves, mapped, *options.clip, layer_z[lu], retraction, clip_samples))
+        return Error{Status::invalid_argument,
+                     "line " + std::to_string(bad) + ": more than 50 million clip samples"};
     // Map the layer's extrusions and wipes.
-    for (std::size_t k = i; k < j; ++k) {
-      if (items[k].kind != Item::move) continue;
-      const Move& m = moves[static_cast<std::size_t>(items[k].index)];
+    for (const Item& it : seq) {
+      if (it.kind != Item::move) continue;
+      const Move& m = moves[static_cast<std::size_t>(it.index)];
       if (!m.has_xy || !(m.extruding() || (m.wipe && m.de <= 0))) continue;
-      ExtrusionPath& p = mapped[static_cast<std::size_t>(items[k].index)];
+      ExtrusionPath& p = mapped[static_cast<std::size_t>(it.index)];
       const Mapped a = map_point(field, m.from, m.h), b = map_point(field, m.to, m.h);
       p.points.push_back(a.p);
       p.height.push_back(a.height);
@@ -423,8 +559,6 @@ Expected<ForeignGcode> map_foreign_gcode(std::string_view text, const LayerField
       }
     }
     if (L.max_z < -1e299) L.max_z = 0;
-    std::vector<Item> seq(items.begin() + static_cast<long>(i),
-                          items.begin() + static_cast<long>(j));
     order_top_skins(seq, moves, mapped);
     // Write.
     double h_sum = 0;
@@ -456,6 +590,8 @@ Expected<ForeignGcode> map_foreign_gcode(std::string_view text, const LayerField
         for (std::size_t q = 1; q < p.points.size(); ++q)
           l3 += (p.points[q] - p.points[q - 1]).norm();
         double f = m.f;
+        if (pending != 0 && m.has_e) w.move(at, at, pending, kNone), pending = 0;
+        if (!m.extruding() && m.has_e) retracted -= m.de;
         if (m.extruding() && !run) {
           ExtrusionPath g;
           g.role = role_of(m.type), g.width = m.width;
@@ -485,11 +621,14 @@ Expected<ForeignGcode> map_foreign_gcode(std::string_view text, const LayerField
       }
       run = nullptr;
       if (!m.has_xy && !m.has_z) {  // retraction, F only
-        w.move(at, at, m.has_e ? m.de : kNone, m.f);
+        if (m.has_e) retracted -= m.de;
+        w.move(at, at, m.has_e ? m.de + pending : kNone, m.f);
+        if (m.has_e) pending = 0;
         continue;
       }
-      // A travel (or a Z move): to the target's place on its layer.
-      const Mapped target = map_point(field, m.to, m.h);
+      // A travel (or a Z move): to the target's place on its layer. A Z move stays where the
+      // nozzle is (not where the file's start G-code left it, when options.start moved it).
+      const Mapped target = map_point(field, m.has_xy ? m.to : Vec3(at.x(), at.y(), m.to.z()), m.h);
       const Vec3 to = target.p;
       const bool curved =
           target.p.z() != m.to.z() || !field.planar_at(m.from.x(), m.from.y()) ||
@@ -497,7 +636,8 @@ Expected<ForeignGcode> map_foreign_gcode(std::string_view text, const LayerField
                               field.t_of_zeta(m.to.z()));
       const double d = (to - at).head<2>().norm();
       const double hop = L.max_slope * (0.5 * d + kTipRadius);
-      const double de = m.has_e ? m.de : kNone;
+      const double de = m.has_e ? m.de + pending : kNone;
+      if (m.has_e) retracted -= m.de, pending = 0;
       if (curved && m.has_xy && (d > 0.6 || std::abs(to.z() - at.z()) > 0.1 || hop > 0.05)) {
         const double lift = d > 0.6 || std::abs(to.z() - at.z()) > 0.1
                                 ? std::max({L.max_z, at.z(), to.z()}) + 0.3
@@ -528,11 +668,15 @@ Expected<ForeignGcode> map_foreign_gcode(std::string_view text, const LayerField
     i = j;
     if (ctx.cancelled()) return Error{Status::cancelled, "cancelled"};
   }
+  out.print_end = w.out.size();
+  out.end_at = at, out.retracted = retracted, out.relative_e_at_end = rel_e_at_end;
   // The end G-code as written, after telling the firmware the file's own E (absolute E).
   if (print_end < lines.size() && !rel_e_at_end) w.line("G92 E%.5f", e_at_end);
   if (print_end < lines.size() && rel_xyz_at_end) w.raw("G91 ; as the file had it here");
   for (; i < lines.size(); ++i) w.raw(items[i].raw);
   out.text = std::move(w.out);
+  for (std::size_t k = dropped.size(); k-- > 0;)
+    if (dropped[k]) out.layers.erase(out.layers.begin() + static_cast<long>(k));
   return out;
 }
 

@@ -150,7 +150,8 @@ Expected<TriangleMesh> parse_3mf(std::string_view data) {
 
 namespace nonplanar {
 
-Expected<bool> write_3mf(const std::filesystem::path& file, const TriangleMesh& mesh) {
+Expected<bool> write_3mf(const std::filesystem::path& file, const TriangleMesh& mesh,
+                         const std::vector<PackageFile>& extra) {
   using io::Handle;
   Handle model, obj, item, writer;
   if (NMR::lib3mf_createmodel(&model.p) != 0 ||
@@ -167,6 +168,15 @@ Expected<bool> write_3mf(const std::filesystem::path& file, const TriangleMesh& 
       NMR::lib3mf_model_addbuilditem(model.p, obj.p, nullptr, &item.p) != 0 ||
       NMR::lib3mf_model_querywriter(model.p, "3mf", &writer.p) != 0)
     return Error{Status::internal_error, file.string() + ": " + io::last_error(model.p)};
+  if (!extra.empty()) NMR::lib3mf_model_addcustomcontenttypeutf8(model.p, "txt", "text/plain");
+  for (const PackageFile& f : extra) {
+    Handle att;
+    std::string path = f.path, type = "http://schemas.nonplanar.org/3mf/attachment";
+    std::vector<BYTE> bytes(f.content.begin(), f.content.end());
+    if (NMR::lib3mf_model_addattachmentutf8(model.p, path.data(), type.data(), &att.p) != 0 ||
+        NMR::lib3mf_attachment_readfrombuffer(att.p, bytes.data(), bytes.size()) != 0)
+      return Error{Status::internal_error, file.string() + ": " + io::last_error(model.p)};
+  }
   ULONG64 size = 0;
   if (NMR::lib3mf_writer_getstreamsize(writer.p, &size) != 0)
     return Error{Status::internal_error, file.string() + ": " + io::last_error(writer.p)};

@@ -15,6 +15,7 @@
 // a = t − h_min − m and h_k <= h_max − h_min − 2m keep it inside [h_min + m, h_max − m].
 #pragma once
 
+#include <algorithm>
 #include <string>
 #include <vector>
 
@@ -62,7 +63,7 @@ ShellPlan choose_shell(const TriangleMesh& mesh, const Analysis& a, const LayerP
 
 /// The shell's layer field: T = N + (z − H)/t, ζ = t·T, so the normalised mesh holds the
 /// shell's layers as planes ζ = j·t … (j + 1)·t. Every column is curved.
-class ShellField final : public LayerField {
+class ShellField : public LayerField {
  public:
   explicit ShellField(const ShellPlan& plan) : s_(plan) {}
   double T(double x, double y, double z) const override {
@@ -77,8 +78,19 @@ class ShellField final : public LayerField {
   bool planar_at(double, double) const override { return false; }
   bool planar_along(const Vec2&, const Vec2&, double, double) const override { return false; }
 
- private:
+ protected:
   const ShellPlan& s_;
+};
+
+/// ShellField for mapping the shell's toolpaths back: its lowest boundary (t = 0) is the core's
+/// top Z_c instead of B, so a point on the lowest layer is as thick as what it fills
+/// (ShellPlan::thickness), and so is its extrusion.
+class ShellPathField final : public ShellField {
+ public:
+  using ShellField::ShellField;
+  double z_at(double x, double y, double t) const override {
+    return t < 0.5 ? std::max(s_.core_top(x, y), 0.0) : ShellField::z_at(x, y, t);
+  }
 };
 
 }  // namespace nonplanar::layers

@@ -6,6 +6,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -70,28 +71,99 @@ std::vector<std::string> engine_forced_settings(const EngineParams& e, const Pri
   return s;
 }
 
+std::vector<std::string> engine_shell_settings() {
+  return {"core: its layer boundaries from a 3MF layer-height profile (flat floors land on them)",
+          "shell: sliced by a second run: skirts = 0, brim_width = 0, first_layer_speed = 100%, "
+          "first_layer_extrusion_width = 0, elefant_foot_compensation = 0, "
+          "disable_fan_first_layers = 0, raft_layers = 0"};
+}
+
+namespace {
+
+// PrusaSlicer's layer-height profile for layers ending at `tops`, then `h` up to `top`: pairs
+// (z, height) it interpolates linearly, looked up a little above each layer's bottom; each
+// layer gets two equal points (its bottom and middle), so its height is exact.
+std::string layer_profile(const std::vector<double>& tops, double h, double top) {
+  std::string s = "object_id=1|";
+  char buf[64];
+  double b = 0;
+  auto layer = [&](double t) {
+    std::snprintf(buf, sizeof buf, "%.6f;%.6f;%.6f;%.6f;", b, t, b + 0.5 * t, t);
+    s += buf;
+    b += t;
+  };
+  for (double z : tops)
+    if (z > b + 1e-6) layer(z - b), b = z;
+  while (b + h < top - 1e-6) layer(h);
+  std::snprintf(buf, sizeof buf, "%.6f;%.6f\n", top, h);
+  return s + buf;
+}
+
+}  // namespace
+
 Expected<std::string> run_engine(const EngineParams& e, const TriangleMesh& mesh,
-                                 const PrintConfig& c, const Context& ctx) {
+                                 const PrintConfig& c, const Context& ctx, const EngineRun& run) {
   const bool orca = e.engine == Engine::orcaslicer;
   const std::string name = orca ? "OrcaSlicer" : "PrusaSlicer";
   const std::string exe = !e.path.empty() ? e.path : orca ? "orca-slicer" : "prusa-slicer";
   TempDir dir;
   if (dir.path.empty()) return Error{Status::io_error, "engine: cannot make a temporary folder"};
-  const fs::path stl = dir.path / "normalized.stl", out = dir.path / "out.gcode",
-                 log = dir.path / "engine.log", forced = dir.path / "forced.ini";
-  if (auto w = write_stl(stl, mesh); !w) return w.error();
-  const Vec2 centre = c.bed_center();
+  const BoundingBox box = bounding_box(mesh);
+  const bool profile = !orca && !run.layer_tops.empty();
+  const fs::path stl = dir.path / (profile ? "core.3mf" : "normalized.stl"),
+                 out = dir.path / "out.gcode", log = dir.path / "engine.log",
+                 forced = dir.path / "forced.ini";
+  if (profile) {
+    const double top = box.max.z() - box.min.z();
+    std::vector<double> tops;
+    for (double z : run.layer_tops) tops.push_back(z - box.min.z());
+    const PackageFile f{"/Metadata/Slic3r_PE_layer_heights_profile.txt",
+                        layer_profile(tops, c.slice.layer_height, top)};
+    if (auto w = write_3mf(stl, mesh, {f}); !w) return w.error();
+  } else if (auto w = write_stl(stl, mesh); !w) {
+    return w.error();
+  }
+  // Where the part is: the engine centres its box there.
+  const Vec2 centre = 0.5 * (box.min + box.max).head<2>();
   std::vector<std::string> args{exe};
   if (!orca) {
-    // Keys an older PrusaSlicer does not know (arc_fitting, 2.6+) are ignored in a loaded
-    // file but fatal on the command line, so they go in a file loaded last.
-    std::ofstream(forced) << "arc_fitting = disabled\n";
+    // The user's overrides and what we force go in a file loaded after the profile: there a
+    // boolean reads "1" (on the command line it takes no value), and a key an older
+    // PrusaSlicer does not know (arc_fitting, 2.6+) is ignored rather than fatal. What is on
+    // the command line below overrides both.
+    const std::vector<std::pair<std::string, std::string>> slab = {
+        {"skirts", "0"},
+        {"brim_width", "0"},
+        {"first_layer_speed", "100%"},
+        {"first_layer_extrusion_width", "0"},
+        {"elefant_foot_compensation", "0"},
+        {"disable_fan_first_layers", "0"},
+        {"raft_layers", "0"}};
+    auto forced_for_slab = [&](const std::string& key) {
+      return run.slab_layer_height > 0 &&
+             std::any_of(slab.begin(), slab.end(), [&](const auto& kv) { return kv.first == key; });
+    };
+    {
+      std::ofstream ini(forced);
+      for (const auto& [key, value] : e.overrides)
+        if (key != "retract_lift" && key != "spiral_vase" && key != "arc_fitting" &&
+            key != "layer_height" && key != "first_layer_height" && !forced_for_slab(key))
+          ini << key << " = " << value << "\n";
+      ini << "arc_fitting = disabled\n";
+      if (run.slab_layer_height > 0)
+        for (const auto& [key, value] : slab) ini << key << " = " << value << "\n";
+      if (!ini) return Error{Status::io_error, "engine: cannot write " + forced.string()};
+    }
     args.push_back("--export-gcode");
     if (!e.config.empty()) args.insert(args.end(), {"--load", e.config});
+    const double h = run.slab_layer_height > 0 ? run.slab_layer_height : c.slice.layer_height;
+    const double h1 = run.slab_layer_height > 0 ? run.slab_layer_height
+                      : profile                 ? run.layer_tops.front() - box.min.z()
+                                                : c.slice.first_layer_height;
     args.insert(args.end(),
-                {"--load", forced.string(), "--layer-height", num(c.slice.layer_height),
-                 "--first-layer-height", num(c.slice.first_layer_height), "--retract-lift", "0",
-                 "--no-spiral-vase", "--center", num(centre.x()) + "," + num(centre.y())});
+                {"--load", forced.string(), "--layer-height", num(h), "--first-layer-height",
+                 num(h1), "--retract-lift", "0", "--no-spiral-vase", "--center",
+                 num(centre.x()) + "," + num(centre.y())});
     if (e.config.empty()) {
       char bed[160];
       std::snprintf(bed, sizeof bed, "%gx%g,%gx%g,%gx%g,%gx%g", c.bed_min.x(), c.bed_min.y(),
@@ -100,15 +172,6 @@ Expected<std::string> run_engine(const EngineParams& e, const TriangleMesh& mesh
       args.insert(args.end(),
                   {"--bed-shape", bed, "--nozzle-diameter", num(c.paths.nozzle_diameter),
                    "--filament-diameter", num(c.gcode.filament_diameter)});
-    }
-    for (const auto& [key, value] : e.overrides) {
-      if (key == "retract_lift" || key == "spiral_vase" || key == "arc_fitting" ||
-          key == "layer_height" || key == "first_layer_height")
-        continue;  // forced above (the layer heights are the same values)
-      std::string flag = "--" + key;
-      for (char& ch : flag)
-        if (ch == '_') ch = '-';
-      args.insert(args.end(), {flag, value});
     }
     args.insert(args.end(), {"--output", out.string(), stl.string()});
   } else {

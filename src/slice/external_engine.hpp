@@ -13,12 +13,29 @@ namespace nonplanar {
 /// The settings forced on the engine's run, as "key = value" lines for the output's header.
 std::vector<std::string> engine_forced_settings(const EngineParams& e, const PrintConfig& c);
 
-/// Inputs: the engine, the mesh to slice (placed on our bed: its XY box centre stays where it
-/// is), the print settings it must agree with (layer heights, bed centre). Output: the
-/// G-code text the engine wrote. Runs the engine in a temporary folder (removed afterwards)
-/// and stops it on cancellation. Errors: io_error (engine missing, failed: its last output
-/// line), cancelled.
+/// What one run asks of the engine beyond the profile (PrusaSlicer only: OrcaSlicer's command
+/// line cannot say it).
+struct EngineRun {
+  /// The layers' tops z_1 < z_2 < … (mm above the mesh's lowest point), given as a 3MF
+  /// layer-height profile; past the last, layers of layer_height up to the mesh's top. Empty:
+  /// first_layer_height, then layer_height.
+  std::vector<double> layer_tops;
+  /// > 0: a slab printed over earlier work (the shell), in layers of this height (mm): no
+  /// skirt or brim, and its first layer printed like the others (speed, width, fan, no
+  /// elephant-foot compensation).
+  double slab_layer_height = 0;
+};
+
+/// The settings the shell route forces on its two runs (header lines).
+std::vector<std::string> engine_shell_settings();
+
+/// Inputs: the engine, the mesh to slice (lowest point on the bed; its XY box centre stays
+/// where it is), the print settings it must agree with (layer heights), what this run asks.
+/// Output: the G-code text the engine wrote. Runs the engine in a temporary folder (removed
+/// afterwards) and stops it on cancellation. Errors: io_error (engine missing, failed: its
+/// last output line), cancelled.
 Expected<std::string> run_engine(const EngineParams& e, const TriangleMesh& mesh,
-                                 const PrintConfig& c, const Context& ctx);
+                                 const PrintConfig& c, const Context& ctx,
+                                 const EngineRun& run = {});
 
 }  // namespace nonplanar

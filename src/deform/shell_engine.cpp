@@ -1,0 +1,143 @@
+// Notation as in layers/shell_plan.hpp: H the top, N shell layers of thickness t, B = H − N·t,
+// a the reach; the core's layer with top z is printed where z <= B + a.
+#include "deform/shell_engine.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cstdio>
+#include <map>
+
+#include "nonplanar/deform.hpp"
+#include "slice/external_engine.hpp"
+
+namespace nonplanar {
+namespace {
+
+// The core's layers cut back under the shell: kept where H − N·t + a − z >= 0.
+class CoreClip final : public LayerClip {
+ public:
+  explicit CoreClip(const layers::ShellPlan& p) : p_(p) {
+    const auto [lo, hi] = std::minmax_element(p.top.h.begin(), p.top.h.end());
+    lo_ = *lo, hi_ = *hi;
+  }
+  Cover cover(double z) const override {
+    const double level = z - p_.reach + p_.N * p_.t;
+    return level <= lo_ ? Cover::all : level > hi_ ? Cover::none : Cover::some;
+  }
+  double margin(double x, double y, double z) const override {
+    return p_.top.height(x, y) - p_.N * p_.t + p_.reach - z;
+  }
+
+ private:
+  const layers::ShellPlan& p_;
+  double lo_ = 0, hi_ = 0;
+};
+
+}  // namespace
+
+TriangleMesh cut_below(const TriangleMesh& mesh, double z0) {
+  TriangleMesh out;
+  std::vector<int> kept(mesh.vertices.size(), -1);
+  std::map<std::pair<int, int>, int> cuts;  // edge (lower index first) → its cut vertex
+  auto vertex = [&](int v) {
+    if (kept[static_cast<std::size_t>(v)] < 0) {
+      kept[static_cast<std::size_t>(v)] = static_cast<int>(out.vertices.size());
+      out.vertices.push_back(mesh.vertices[static_cast<std::size_t>(v)]);
+    }
+    return kept[static_cast<std::size_t>(v)];
+  };
+  auto cut = [&](int a, int b) {
+    if (a > b) std::swap(a, b);
+    auto [it, fresh] = cuts.try_emplace({a, b}, 0);
+    if (fresh) {
+      const Vec3& p = mesh.vertices[static_cast<std::size_t>(a)];
+      const Vec3& q = mesh.vertices[static_cast<std::size_t>(b)];
+      Vec3 c = p + (z0 - p.z()) / (q.z() - p.z()) * (q - p);
+      c.z() = z0;
+      it->second = static_cast<int>(out.vertices.size());
+      out.vertices.push_back(c);
+    }
+    return it->second;
+  };
+  for (const auto& f : mesh.faces) {
+    // The face's polygon above z0 (a vertex on z0 counts as above), in its own order.
+    std::array<int, 4> poly{};
+    int n = 0;
+    for (int k = 0; k < 3; ++k) {
+      const int a = f[static_cast<std::size_t>(k)], b = f[static_cast<std::size_t>((k + 1) % 3)];
+      const bool in_a = mesh.vertices[static_cast<std::size_t>(a)].z() >= z0;
+      const bool in_b = mesh.vertices[static_cast<std::size_t>(b)].z() >= z0;
+      if (in_a) poly[static_cast<std::size_t>(n++)] = vertex(a);
+      if (in_a != in_b) poly[static_cast<std::size_t>(n++)] = cut(a, b);
+    }
+    for (int k = 1; k + 1 < n; ++k)
+      out.faces.push_back(
+          {poly[0], poly[static_cast<std::size_t>(k)], poly[static_cast<std::size_t>(k + 1)]});
+  }
+  return out;
+}
+
+Expected<EngineShell> shell_with_engine(const TriangleMesh& mesh, const layers::ShellPlan& plan,
+                                        const SliceJob& job, const Context& ctx) {
+  // The core: the whole mesh sliced on the plan's boundaries (its skins then sit under the
+  // real top, so the shell counts as their cover), each layer cut back under the shell.
+  EngineRun core_run;
+  core_run.layer_tops.assign(plan.core.begin() + 1, plan.core.end());
+  auto core_text = run_engine(job.engine, mesh, job.print, ctx, core_run);
+  if (!core_text) return core_text.error();
+  const CoreClip clip(plan);
+  ForeignMapOptions core_opt;
+  core_opt.clip = &clip;
+  const auto planar = planar_field(job.layers);
+  auto core = map_foreign_gcode(*core_text, *planar, {}, ctx, core_opt);
+  if (!core) {
+    Error e = core.error();
+    e.message = "engine G-code (core), " + e.message;
+    return e;
+  }
+  ctx.progress("core", 1.0);
+
+  // The shell: the normalised mesh's slab 0 <= ζ <= N·t, entered from where the core ended.
+  const layers::ShellField field(plan);
+  auto normalized = normalize_mesh(mesh, field, {}, ctx);
+  if (!normalized) return normalized.error();
+  EngineRun shell_run;
+  shell_run.slab_layer_height = plan.t;
+  auto shell_text =
+      run_engine(job.engine, cut_below(normalized->mesh, 0.0), job.print, ctx, shell_run);
+  if (!shell_text) return shell_text.error();
+  const layers::ShellPathField path_field(plan);
+  ForeignMapOptions shell_opt;
+  shell_opt.start = core->end_at;
+  shell_opt.start_retracted = core->retracted;
+  auto shell = map_foreign_gcode(*shell_text, path_field, {}, ctx, shell_opt);
+  if (!shell) {
+    Error e = shell.error();
+    e.message = "engine G-code (shell), " + e.message;
+    return e;
+  }
+
+  // Stitch: the core's program up to its end G-code, the shell's print, the core's end.
+  EngineShell out;
+  const std::string& c = core->text;
+  const std::string& s = shell->text;
+  out.gcode.reserve(c.size() + s.size() + 256);
+  out.gcode.append(c, 0, core->print_end);
+  out.gcode += "; nonplanar: the shell's curved layers, from the engine's second run\n";
+  out.gcode += shell->relative_e_at_print ? "M83\n" : "M82\n";
+  if (!shell->fan_at_print.empty()) out.gcode += shell->fan_at_print + "\n";
+  char buf[64];
+  if (!shell->relative_e_at_print) {
+    std::snprintf(buf, sizeof buf, "G92 E%.5f\n", shell->e_at_print);
+    out.gcode += buf;
+  }
+  out.gcode.append(s, shell->print_begin, shell->print_end - shell->print_begin);
+  out.gcode += "; nonplanar: the core run's end G-code\n";
+  out.gcode += core->relative_e_at_end ? "M83\n" : "M82\n";
+  out.gcode.append(c, core->print_end, std::string::npos);
+  out.layers = std::move(core->layers);
+  for (LayerToolpaths& L : shell->layers) out.layers.push_back(std::move(L));
+  return out;
+}
+
+}  // namespace nonplanar

@@ -1,0 +1,33 @@
+// A shell over a planar core (layers/shell_plan.hpp) printed by an external engine
+// (PrusaSlicer): two runs of it, stitched into one program.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "layers/shell_plan.hpp"
+#include "nonplanar/pipeline.hpp"
+
+namespace nonplanar {
+
+struct EngineShell {
+  std::string gcode;                   ///< the whole program, without our header
+  std::vector<LayerToolpaths> layers;  ///< core bottom to top, then the shell, for the gate
+};
+
+/// The part above z0 of a closed mesh, open along the cut (nothing is sliced there: an engine
+/// slicing it from z0 up sees closed sections). Triangles crossing z0 are clipped; the cut
+/// points of an edge are computed from its ends in one order, so neighbours agree.
+TriangleMesh cut_below(const TriangleMesh& mesh, double z0);
+
+/// Inputs: the placed mesh, an accepted plan (plan.refused empty), the job (its engine is
+/// PrusaSlicer). Output: one program: the core run's start G-code and layers, each cut back to
+/// where z_k <= B + a (as shell_toolpaths), then the shell run's layers mapped onto the shell
+/// (entered from where the core ended, its retraction given back), then the core run's end
+/// G-code. The core run slices the mesh on the plan's layer boundaries (a 3MF layer-height
+/// profile); the shell run slices the normalised mesh above ζ = 0 as a slab (no skirt,
+/// first-layer settings neutral). Errors: those of the engine and the mapping; cancelled.
+Expected<EngineShell> shell_with_engine(const TriangleMesh& mesh, const layers::ShellPlan& plan,
+                                        const SliceJob& job, const Context& ctx);
+
+}  // namespace nonplanar

@@ -1,0 +1,111 @@
+// The shell route through an external engine (src/deform/shell_engine.cpp): the slab cut
+// from the normalised mesh, and the core's layers cut back (map_foreign_gcode's clip).
+#include <gtest/gtest.h>
+
+#include <map>
+
+#include "deform/shell_engine.hpp"
+#include "nonplanar/deform.hpp"
+#include "support/solids.hpp"
+
+namespace nonplanar {
+namespace {
+
+double area(const TriangleMesh& m) {
+  double a = 0;
+  for (const auto& f : m.faces) {
+    const Vec3& p = m.vertices[static_cast<std::size_t>(f[0])];
+    a += 0.5 * (m.vertices[static_cast<std::size_t>(f[1])] - p)
+                   .cross(m.vertices[static_cast<std::size_t>(f[2])] - p)
+                   .norm();
+  }
+  return a;
+}
+
+// Edges used by one face only: (length, all on z0).
+std::pair<double, bool> open_edges(const TriangleMesh& m, double z0) {
+  std::map<std::pair<int, int>, int> uses;
+  for (const auto& f : m.faces)
+    for (int k = 0; k < 3; ++k) {
+      int a = f[static_cast<std::size_t>(k)], b = f[static_cast<std::size_t>((k + 1) % 3)];
+      if (a > b) std::swap(a, b);
+      ++uses[{a, b}];
+    }
+  double len = 0;
+  bool on = true;
+  for (const auto& [e, n] : uses) {
+    if (n != 1) continue;
+    const Vec3& p = m.vertices[static_cast<std::size_t>(e.first)];
+    const Vec3& q = m.vertices[static_cast<std::size_t>(e.second)];
+    len += (q - p).norm();
+    on = on && std::abs(p.z() - z0) < 1e-12 && std::abs(q.z() - z0) < 1e-12;
+  }
+  return {len, on};
+}
+
+TEST(CutBelow, KeepsTheMeshAboveOpenAlongTheCut) {
+  const TriangleMesh box = test::box({0, 0, 0}, {10, 10, 10});
+  const TriangleMesh cut = cut_below(box, 2.5);
+  for (const Vec3& v : cut.vertices) EXPECT_GE(v.z(), 2.5);
+  EXPECT_NEAR(area(cut), 100 + 4 * 10 * 7.5, 1e-9);  // the top and the walls above 2.5
+  const auto [len, on] = open_edges(cut, 2.5);
+  EXPECT_NEAR(len, 40.0, 1e-9);  // the cut's outline, and nothing else open
+  EXPECT_TRUE(on);
+  // A cut under the mesh keeps it whole and closed.
+  const TriangleMesh whole = cut_below(box, -1);
+  EXPECT_NEAR(area(whole), 600, 1e-9);
+  EXPECT_NEAR(open_edges(whole, -1).first, 0.0, 1e-12);
+  EXPECT_TRUE(cut_below(box, 11).faces.empty());
+}
+
+// Keeps x <= 4 on layers up to 0.3 mm, nothing above.
+class LeftOfFour final : public LayerClip {
+ public:
+  Cover cover(double z) const override { return z < 0.3 ? Cover::some : Cover::none; }
+  double margin(double x, double, double) const override { return 4 - x; }
+};
+
+TEST(MapForeignGcode, ClipsLayersAndEntersFromAGivenStart) {
+  const std::string g =
+      "M83\nM106 S100\n"
+      ";LAYER_CHANGE\n;Z:0.2\n;HEIGHT:0.2\nG1 Z0.2 F600\nG1 X0 Y0 F6000\n"
+      "G1 E-1 F2400\nG1 E1 F2400\n"
+      ";TYPE:Perimeter\nG1 X10 Y0 E1 F1200\nG1 X10 Y10 E1\nG1 E-0.8 F2400\n"
+      ";LAYER_CHANGE\n;Z:0.4\n;HEIGHT:0.2\nG1 Z0.4\nM106 S200\nM104 S210\n"
+      ";TYPE:Perimeter\nG1 X0 Y10 E1\n"
+      ";TYPE:Custom\nM107\nG28\n";
+  const auto field = planar_field({});
+  const LeftOfFour clip;
+  ForeignMapOptions o;
+  o.clip = &clip;
+  o.start = Vec3(50, 50, 5);
+  o.start_retracted = 0.5;
+  auto r = map_foreign_gcode(g, *field, {}, {}, o);
+  ASSERT_TRUE(r) << r.error().message;
+  const std::string& t = r->text;
+  // The kept piece extrudes its share; the rest is travel, retracted around (6 and 10 mm).
+  EXPECT_NE(t.find("G1 X4.000 Y0.000 E0.40000 F1200"), std::string::npos) << t;
+  EXPECT_NE(t.find("G1 E-1.00000 F2400\nG1 X10.000 Y0.000 F1200\nG1 E1.00000 F2400"),
+            std::string::npos)
+      << t;
+  ASSERT_EQ(r->layers.size(), 1u);  // the second layer is left out ...
+  double len = 0;
+  for (const ExtrusionPath& p : r->layers[0].paths)
+    for (std::size_t k = 1; k < p.points.size(); ++k) len += (p.points[k] - p.points[k - 1]).norm();
+  EXPECT_NEAR(len, 4.0, 1e-6);
+  EXPECT_EQ(t.find("M106 S200"), std::string::npos);  // ... but for its temperature
+  EXPECT_NE(t.find("M104 S210"), std::string::npos);
+  // Entered from the given start: the Z move stays over it; the retraction owed is given back.
+  EXPECT_NE(t.find(";HEIGHT:0.200\nG1 Z0.200 F600\nG1 X0.000 Y0.000 F6000\nG1 E-0.50000 F2400"),
+            std::string::npos)
+      << t;
+  EXPECT_EQ(t.substr(r->print_begin).rfind(";LAYER_CHANGE", 0), 0u);
+  EXPECT_EQ(t.substr(r->print_end), ";TYPE:Custom\nM107\nG28\n");
+  EXPECT_NEAR(r->retracted, 0.8, 1e-9);
+  EXPECT_TRUE(r->end_at.isApprox(Vec3(10, 10, 0.2)));
+  EXPECT_EQ(r->fan_at_print, "M106 S100");
+  EXPECT_TRUE(r->relative_e_at_print);
+}
+
+}  // namespace
+}  // namespace nonplanar
