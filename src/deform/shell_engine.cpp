@@ -95,6 +95,20 @@ Expected<EngineShell> shell_with_engine(const TriangleMesh& mesh, const layers::
     e.message = "engine G-code (core), " + e.message;
     return e;
   }
+  // An engine that ignored the profile would leave the stairs other than planned, and the
+  // shell's lowest layer thicker or thinner than the gate believes: refuse such a core.
+  for (const LayerToolpaths& L : core->layers) {
+    if (L.paths.empty()) continue;
+    const auto near = std::lower_bound(plan.core.begin(), plan.core.end(), L.max_z - 2e-3);
+    if (near == plan.core.end() || *near > L.max_z + 2e-3) {
+      char buf[160];
+      std::snprintf(buf, sizeof buf,
+                    "the engine's core has a layer at z = %.3f mm, not on the planned "
+                    "boundaries (did it ignore the 3MF layer-height profile?)",
+                    L.max_z);
+      return Error{Status::unsupported, buf};
+    }
+  }
   ctx.progress("core", 1.0);
 
   // The shell: the normalised mesh's slab 0 <= ζ <= N·t, entered from where the core ended.

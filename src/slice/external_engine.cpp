@@ -71,11 +71,14 @@ std::vector<std::string> engine_forced_settings(const EngineParams& e, const Pri
   return s;
 }
 
-std::vector<std::string> engine_shell_settings() {
-  return {"core: its layer boundaries from a 3MF layer-height profile (flat floors land on them)",
-          "shell: sliced by a second run: skirts = 0, brim_width = 0, first_layer_speed = 100%, "
-          "first_layer_extrusion_width = 0, elefant_foot_compensation = 0, "
-          "disable_fan_first_layers = 0, raft_layers = 0"};
+std::vector<std::string> engine_shell_settings(double first_layer) {
+  return {
+      "core: its layer boundaries from a 3MF layer-height profile (flat floors land on them), "
+      "first_layer_height = " +
+          num(first_layer),
+      "shell: sliced by a second run: skirts = 0, brim_width = 0, first_layer_speed = 100%, "
+      "first_layer_extrusion_width = 0, elefant_foot_compensation = 0, "
+      "disable_fan_first_layers = 0, raft_layers = 0"};
 }
 
 namespace {

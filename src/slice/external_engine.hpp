@@ -16,7 +16,7 @@ std::vector<std::string> engine_forced_settings(const EngineParams& e, const Pri
 /// What one run asks of the engine beyond the profile (PrusaSlicer only: OrcaSlicer's command
 /// line cannot say it).
 struct EngineRun {
-  /// The layers' tops z_1 < z_2 < … (mm above the mesh's lowest point), given as a 3MF
+  /// The layers' tops z_1 < z_2 < … (mm, the mesh's own z; its lowest point is z_0), given as a 3MF
   /// layer-height profile; past the last, layers of layer_height up to the mesh's top. Empty:
   /// first_layer_height, then layer_height.
   std::vector<double> layer_tops;
@@ -26,8 +26,9 @@ struct EngineRun {
   double slab_layer_height = 0;
 };
 
-/// The settings the shell route forces on its two runs (header lines).
-std::vector<std::string> engine_shell_settings();
+/// The settings the shell route forces on its two runs (header lines); first_layer: the core's
+/// first layer height, mm.
+std::vector<std::string> engine_shell_settings(double first_layer);
 
 /// Inputs: the engine, the mesh to slice (lowest point on the bed; its XY box centre stays
 /// where it is), the print settings it must agree with (layer heights), what this run asks.

@@ -3,7 +3,10 @@
 // not installed (scripts/test.sh installs it).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdlib>
+#include <filesystem>
+#include <fstream>
 
 #include "nonplanar/check.hpp"
 #include "nonplanar/io.hpp"
@@ -113,6 +116,33 @@ TEST(EnginePrusaSlicer, WingPrintsAsAShellOverItsCore) {
   EXPECT_EQ(count("; prusaslicer_config = begin"), 1u);
   EXPECT_NE(r->gcode.find("; engine setting: shell: sliced by a second run"), std::string::npos);
   EXPECT_NE(r->gcode.find("; use_relative_e_distances = 1"), std::string::npos);
+}
+
+// An engine that does not slice on the planned boundaries (here: one that forces its own first
+// layer) must not get its core under the shell: the part is sliced planar, with a notice.
+TEST(EnginePrusaSlicer, ACoreOffThePlannedBoundariesFallsBackToPlanar) {
+  if (!have_prusaslicer()) GTEST_SKIP() << "prusa-slicer not installed";
+  const auto models = test::shared_models();
+  if (models.empty()) GTEST_SKIP() << "../shared/models not present";
+  auto m = load_mesh(models / "np_curvislicer_wing.stl", {}, {});
+  ASSERT_TRUE(m);
+  const auto dir = test::temp_dir("engine_off_plan");
+  const auto fake = dir / "engine.sh";
+  { std::ofstream(fake) << "#!/bin/sh\nexec prusa-slicer \"$@\" --first-layer-height 0.3\n"; }
+  std::filesystem::permissions(fake, std::filesystem::perms::owner_all);
+  PrintConfig c;
+  SliceJob job = make_job(c);
+  job.engine.engine = Engine::prusaslicer;
+  job.engine.path = fake.string();
+  auto r = slice_model(m->mesh, job, {});
+  ASSERT_TRUE(r) << r.error().message;
+  EXPECT_EQ(r->shell_layers, 0);
+  EXPECT_FALSE(r->nonplanar);
+  const bool said = std::any_of(r->notices.begin(), r->notices.end(), [](const std::string& n) {
+    return n.find("not printed as a shell: the engine's core has a layer at z = 0.300") !=
+           std::string::npos;
+  });
+  EXPECT_TRUE(said);
 }
 
 TEST(EngineOption, BadEngineOrMissingExecutableIsAOneLineError) {
