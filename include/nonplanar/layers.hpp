@@ -133,7 +133,9 @@ class LayerField {
   /// default samples planar_at every 0.1 mm (and ignores t).
   virtual bool planar_along(const Vec2& a, const Vec2& b, double t_lo, double t_hi) const {
     (void)t_lo, (void)t_hi;
-    const int n = 1 + static_cast<int>((b - a).norm() / 0.1);
+    const double len = (b - a).norm();
+    if (!(len < 1e5)) return false;  // 100 m (or NaN): no print; "curved" is the safe answer
+    const int n = 1 + static_cast<int>(len / 0.1);
     for (int i = 0; i <= n; ++i) {
       const Vec2 p = a + (b - a) * (static_cast<double>(i) / n);
       if (!planar_at(p.x(), p.y())) return false;

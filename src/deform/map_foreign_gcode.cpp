@@ -453,8 +453,9 @@ Expected<ForeignGcode> map_foreign_gcode(std::string_view text, const LayerField
           return fail("unknown word '" + std::string(w.substr(0, 20)) + "' in a move");
       }
       // No printer is 10 m across: such a coordinate is a broken file, and mapping its
-      // moves in 1 mm pieces would not fit in memory.
-      if (in_print && m.to.cwiseAbs().maxCoeff() > 1e4)
+      // moves in 1 mm pieces would not fit in memory. The move's start counts too: the start
+      // G-code (not checked) may have left the nozzle there.
+      if (in_print && std::max(m.to.cwiseAbs().maxCoeff(), m.from.cwiseAbs().maxCoeff()) > 1e4)
         return fail("coordinate beyond 10 m: not a print this can map");
       pos = m.to;
       if (!std::isnan(m.f)) feed = m.f;

@@ -117,6 +117,12 @@ TEST(MapForeignGcode, RefusesWhatItCannotMapNamingTheLine) {
   ASSERT_FALSE(word);
   EXPECT_NE(word.error().message.find("line 7"), std::string::npos);
   EXPECT_FALSE(map_foreign_gcode("G1 X1 Y1 E1\n", *field, {}, {}));  // no layers
+  // A start G-code that leaves the nozzle 2.5e12 mm away (found by the fuzzer: the travel
+  // back was sampled every 0.1 mm into an int).
+  auto far = map_foreign_gcode("G1 X2555555555555 Y0\n" + head.substr(4), *field, {}, {});
+  ASSERT_FALSE(far);
+  EXPECT_NE(far.error().message.find("line 6: coordinate beyond 10 m"), std::string::npos)
+      << far.error().message;
   // Start G-code before the first layer passes untouched, whatever it holds.
   auto ok = map_foreign_gcode("M862.3 P \"MK3S\"\nG29 ; mesh\n" + head.substr(8) + "G92 E0\n",
                               *field, {}, {});
