@@ -21,11 +21,11 @@ class CoreClip final : public LayerClip {
     lo_ = *lo, hi_ = *hi;
   }
   Cover cover(double z) const override {
-    const double level = z - p_.reach + p_.N * p_.t;
+    const double level = p_.core_level(z);
     return level <= lo_ ? Cover::all : level > hi_ ? Cover::none : Cover::some;
   }
   double margin(double x, double y, double z) const override {
-    return p_.top.height(x, y) - p_.N * p_.t + p_.reach - z;
+    return p_.top.height(x, y) - p_.core_level(z);
   }
 
  private:

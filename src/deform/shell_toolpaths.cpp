@@ -30,7 +30,7 @@ Expected<std::vector<LayerToolpaths>> shell_toolpaths(const TriangleMesh& mesh,
   const layers::ContourIndex index(plan.top);
   tbb::parallel_for(std::size_t{0}, core->size(), [&](std::size_t k) {
     SlicedLayer& L = (*core)[k];
-    const double level = L.z_top - plan.reach + plan.N * plan.t;
+    const double level = plan.core_level(L.z_top);
     if (level <= h_lo || L.islands.empty()) return;
     // The shell over the part cut away counts as cover for the skins below, so they are as
     // thick (shell included) as top_solid_layers asks, not that plus the shell.

@@ -34,6 +34,8 @@ struct ShellPlan {
   std::string refused;       ///< why the part cannot be printed this way (empty: it can)
 
   double bottom(double x, double y) const { return top.height(x, y) - N * t; }
+  /// The core's layer with top z is printed where H >= this level (z <= B + a), mm.
+  double core_level(double z) const { return z - reach + N * t; }
   /// U_j(x, y).
   double layer_top(int j, double x, double y) const { return top.height(x, y) - (N - 1 - j) * t; }
   /// Z_c(x, y): the top of the highest core layer printed under (x, y); 0 (the bed) if none.

@@ -71,14 +71,24 @@ std::vector<std::string> engine_forced_settings(const EngineParams& e, const Pri
   return s;
 }
 
+// What the shell's slab run forces: no skirt or brim, its first layer like the others.
+const std::pair<const char*, const char*> kSlab[] = {{"skirts", "0"},
+                                                     {"brim_width", "0"},
+                                                     {"first_layer_speed", "100%"},
+                                                     {"first_layer_extrusion_width", "0"},
+                                                     {"elefant_foot_compensation", "0"},
+                                                     {"disable_fan_first_layers", "0"},
+                                                     {"raft_layers", "0"}};
+
 std::vector<std::string> engine_shell_settings(double first_layer) {
+  std::string slab = "shell: sliced by a second run:";
+  for (const auto& [key, value] : kSlab) slab += std::string(" ") + key + " = " + value + ",";
+  slab.pop_back();
   return {
       "core: its layer boundaries from a 3MF layer-height profile (flat floors land on them), "
       "first_layer_height = " +
           num(first_layer),
-      "shell: sliced by a second run: skirts = 0, brim_width = 0, first_layer_speed = 100%, "
-      "first_layer_extrusion_width = 0, elefant_foot_compensation = 0, "
-      "disable_fan_first_layers = 0, raft_layers = 0"};
+      slab};
 }
 
 namespace {
@@ -134,17 +144,10 @@ Expected<std::string> run_engine(const EngineParams& e, const TriangleMesh& mesh
     // boolean reads "1" (on the command line it takes no value), and a key an older
     // PrusaSlicer does not know (arc_fitting, 2.6+) is ignored rather than fatal. What is on
     // the command line below overrides both.
-    const std::vector<std::pair<std::string, std::string>> slab = {
-        {"skirts", "0"},
-        {"brim_width", "0"},
-        {"first_layer_speed", "100%"},
-        {"first_layer_extrusion_width", "0"},
-        {"elefant_foot_compensation", "0"},
-        {"disable_fan_first_layers", "0"},
-        {"raft_layers", "0"}};
     auto forced_for_slab = [&](const std::string& key) {
       return run.slab_layer_height > 0 &&
-             std::any_of(slab.begin(), slab.end(), [&](const auto& kv) { return kv.first == key; });
+             std::any_of(std::begin(kSlab), std::end(kSlab),
+                         [&](const auto& kv) { return key == kv.first; });
     };
     {
       std::ofstream ini(forced);
@@ -154,7 +157,7 @@ Expected<std::string> run_engine(const EngineParams& e, const TriangleMesh& mesh
           ini << key << " = " << value << "\n";
       ini << "arc_fitting = disabled\n";
       if (run.slab_layer_height > 0)
-        for (const auto& [key, value] : slab) ini << key << " = " << value << "\n";
+        for (const auto& [key, value] : kSlab) ini << key << " = " << value << "\n";
       if (!ini) return Error{Status::io_error, "engine: cannot write " + forced.string()};
     }
     args.push_back("--export-gcode");
