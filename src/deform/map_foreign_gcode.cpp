@@ -15,6 +15,7 @@
 #include <cstdarg>
 #include <cstdio>
 #include <limits>
+#include <optional>
 
 #include "deform/map_segment.hpp"
 #include "io/mesh_buffer.hpp"
@@ -251,8 +252,16 @@ int clip_layer(std::vector<Item>& seq, std::vector<Move>& moves, std::vector<Ext
   };
   std::vector<Item> out;
   out.reserve(seq.size());
+  // The give-back of a retraction around cut-away travel: held while the travel goes on (the
+  // next extrusion cut away too, as a whole perimeter above the core often is), added before
+  // anything else.
+  std::optional<Move> owed;
+  auto settle = [&] {
+    if (owed) add(*owed, out), owed.reset();
+  };
   for (const Item& it : seq) {
     if (it.kind != Item::move || !moves[static_cast<std::size_t>(it.index)].extruding()) {
+      settle();
       out.push_back(it);
       continue;
     }
@@ -282,34 +291,47 @@ int clip_layer(std::vector<Item>& seq, std::vector<Move>& moves, std::vector<Ext
       s0 = s1, g0 = g1;
     }
     cuts.push_back(1.0);
-    if (cuts.size() == 2 && g(0.5) >= 0) {
+    // Neighbouring pieces on the same side are one, and a piece under 1 µm takes its
+    // neighbour's side: a margin of exactly 0 (a flat floor the core's boundaries were
+    // snapped to) flips back and forth within a step, or touches 0 at one point.
+    std::vector<double> merged{0.0};
+    std::vector<char> kept;  // per merged piece
+    for (std::size_t k = 0; k + 1 < cuts.size(); ++k) {
+      const bool sliver = k > 0 && (cuts[k + 1] - cuts[k]) * len < 1e-3;
+      const char in = sliver ? kept.back() : g(0.5 * (cuts[k] + cuts[k + 1])) >= 0;
+      if (k > 0 && in != kept.back()) merged.push_back(cuts[k]);
+      if (k == 0 || in != kept.back()) kept.push_back(in);
+    }
+    merged.push_back(1.0);
+    cuts = std::move(merged);
+    if (cuts.size() == 2 && kept[0]) {
       out.push_back(it);
       continue;
     }
-    bool retracted = false;
     for (std::size_t k = 0; k + 1 < cuts.size(); ++k) {
       Move piece = m;
       piece.from = at(cuts[k]), piece.to = at(cuts[k + 1]);
-      piece.f = k == 0 ? m.f : retracted ? m.feed : kNone;
-      retracted = false;
-      if (g(0.5 * (cuts[k] + cuts[k + 1])) >= 0) {
+      piece.f = k == 0 ? m.f : kNone;
+      if (kept[k]) {
+        if (owed) settle(), piece.f = m.feed;  // after the give-back's feed rate
         piece.de = m.de * (cuts[k + 1] - cuts[k]);
         add(piece, out);
         continue;
       }
       piece.de = 0, piece.has_e = false;
-      const bool hop = ret.length > 0 && (piece.to - piece.from).head<2>().norm() > 2.0;
+      const bool hop = ret.length > 0 && (owed || (piece.to - piece.from).head<2>().norm() > 2.0);
       Move r = piece;
-      r.has_xy = false, r.has_e = true, r.to = r.from, r.de = -ret.length, r.f = ret.f;
-      if (hop) add(r, out), piece.f = m.feed;
-      add(piece, out);
-      if (hop) {
-        r.from = r.to = piece.to, r.de = ret.length, r.f = ret.back_f;
+      r.has_xy = false, r.has_e = true;
+      if (hop && !owed) {
+        r.to = r.from, r.de = -ret.length, r.f = ret.f;
         add(r, out);
-        retracted = true;
       }
+      if (hop) piece.f = m.feed;
+      add(piece, out);
+      if (hop) r.from = r.to = piece.to, r.de = ret.length, r.f = ret.back_f, owed = r;
     }
   }
+  settle();
   seq = std::move(out);
   return 0;
 }
