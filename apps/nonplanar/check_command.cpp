@@ -14,20 +14,25 @@ namespace {
 
 struct CheckOptions {
   MeshOptions mesh;
-  std::string gcode, config;
-  CheckParams params;
+  ProfileOptions profile;
+  std::string gcode;
+  double max_angle = 30;
+  // The head, as options too (kept from before the profile carried it).
+  std::string tip_radius, block_radius, block_clearance;
   bool json = false;
 };
 
-int run(CheckOptions o) {
-  PrintConfig cfg;
-  if (!o.config.empty()) {
-    auto c = load_config(o.config);
-    if (!c) return report_error(c.error());
-    cfg = std::move(*c);
-    o.params.filament_diameter = cfg.gcode.filament_diameter;
-    o.params.layer_height = cfg.slice.layer_height;
-  }
+int run(const CheckOptions& o) {
+  std::vector<std::string> head;
+  for (const auto& [key, v] : {std::pair{"nozzle_tip_radius", &o.tip_radius},
+                               {"heater_block_radius", &o.block_radius},
+                               {"heater_block_clearance", &o.block_clearance}})
+    if (!v->empty()) head.push_back(std::string(key) + "=" + *v);
+  auto cfg = o.profile.load(head);
+  if (!cfg) return report_error(cfg.error());
+  if (!(o.max_angle > 0 && o.max_angle < 90))
+    return report_error({Status::invalid_argument, "max_angle: must be in (0, 90) degrees"});
+  const CheckParams params = check_params(*cfg, o.max_angle);
   Context ctx = make_context(o.mesh.quiet || o.json);
   auto bytes = io::read_file_bytes(o.gcode, 2ull << 30);
   if (!bytes)
@@ -38,10 +43,10 @@ int run(CheckOptions o) {
     return finish_progress(),
            report_error({moves.error().status, o.gcode + ": " + moves.error().message});
   LoadParams lp = o.mesh.load;
-  lp.bed_center = cfg.bed_center();
+  lp.bed_center = cfg->bed_center();
   auto mesh = load_mesh(o.mesh.model, lp, ctx);
   if (!mesh) return finish_progress(), report_error(mesh.error());
-  auto f = check_print(*moves, &mesh->mesh, o.params, ctx);
+  auto f = check_print(*moves, &mesh->mesh, params, ctx);
   finish_progress();
   if (!f) return report_error(f.error());
   if (o.json) {
@@ -108,13 +113,13 @@ void register_check(CLI::App& app, std::function<int()>* run_fn) {
       "mesh. Works on PrusaSlicer's G-code too. See docs/check.md for how each is computed.");
   cmd->add_option("gcode", o->gcode, "G-code file")->required();
   cmd->add_option("--mesh", o->mesh.model, "The mesh it was sliced from")->required();
-  cmd->add_option("--config", o->config, "Profile (bed size, filament, layer height)");
+  o->profile.add_to(*cmd, "bed size, filament, layer height, the toolhead");
   cmd->add_option("--scale", o->mesh.load.scale, "Scale applied when slicing");
-  cmd->add_option("--max-angle", o->params.max_angle_deg, "Printable facet slope (deg)")
+  cmd->add_option("--max-angle", o->max_angle, "Printable facet slope (deg)")
       ->capture_default_str();
-  cmd->add_option("--nozzle-tip-radius", o->params.nozzle_tip_radius, "mm")->capture_default_str();
-  cmd->add_option("--block-radius", o->params.block_radius, "mm")->capture_default_str();
-  cmd->add_option("--block-clearance", o->params.block_clearance, "mm")->capture_default_str();
+  cmd->add_option("--nozzle-tip-radius", o->tip_radius, "mm (= --set nozzle_tip_radius=…)");
+  cmd->add_option("--block-radius", o->block_radius, "mm (= --set heater_block_radius=…)");
+  cmd->add_option("--block-clearance", o->block_clearance, "mm (= --set heater_block_clearance=…)");
   cmd->add_flag("--json", o->json, "Print one JSON document");
   cmd->add_flag("-q,--quiet", o->mesh.quiet, "No progress on stderr");
   *run_fn = nullptr;

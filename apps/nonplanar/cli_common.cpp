@@ -45,6 +45,38 @@ void MeshOptions::add_to(CLI::App& cmd) {
   cmd.add_flag("-q,--quiet", quiet, "No progress or warnings on stderr");
 }
 
+void ProfileOptions::add_to(CLI::App& cmd, const std::string& what) {
+  cmd.add_option("--config", config, "Profile: .json or PrusaSlicer .ini (" + what + ")");
+  cmd.add_option("--set", sets,
+                 "Any setting by its key, after the profile: --set KEY=VALUE (e.g.\n"
+                 "nozzle_cone_angle=40, toolhead_shape=prusa_mk3s; docs/toolhead.md)");
+}
+
+Expected<std::pair<std::string, std::string>> apply_setting(PrintConfig& c, const std::string& kv) {
+  const auto eq = kv.find('=');
+  if (eq == std::string::npos)
+    return Error{Status::invalid_argument, "--set: expected KEY=VALUE, got '" + kv + "'"};
+  std::pair<std::string, std::string> p{kv.substr(0, eq), kv.substr(eq + 1)};
+  auto r = set_config_value(c, p.first, p.second);
+  if (!r) return Error{Status::invalid_argument, "--" + r.error().message};
+  if (!*r) return Error{Status::invalid_argument, "unknown setting '" + p.first + "'"};
+  return p;
+}
+
+Expected<PrintConfig> ProfileOptions::load(const std::vector<std::string>& extra) const {
+  PrintConfig cfg;
+  if (!config.empty()) {
+    auto c = load_config(config);
+    if (!c) return c.error();
+    cfg = std::move(*c);
+  }
+  for (const auto* list : {&extra, &sets})
+    for (const std::string& kv : *list)
+      if (auto r = apply_setting(cfg, kv); !r) return r.error();
+  if (auto v = validate_config(cfg); !v) return v.error();
+  return cfg;
+}
+
 void add_analysis_options(CLI::App& cmd, AnalysisParams& p) {
   cmd.add_option("--max-angle", p.max_angle_deg,
                  "Steepest printable face, degrees from horizontal (nozzle geometry)")

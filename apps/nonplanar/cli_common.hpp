@@ -4,6 +4,8 @@
 
 #include <CLI/CLI.hpp>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "nonplanar/analysis.hpp"
 #include "nonplanar/config.hpp"
@@ -30,6 +32,21 @@ struct MeshOptions {
   bool quiet = false;
   void add_to(CLI::App& cmd);
 };
+
+/// The print profile a subcommand reads: --config FILE, then --set KEY=VALUE in order (any
+/// PrusaSlicer key we read, and ours: the toolhead's keys, docs/toolhead.md).
+struct ProfileOptions {
+  std::string config;
+  std::vector<std::string> sets;
+  /// `what` names the subcommand's use of the profile in --config's help.
+  void add_to(CLI::App& cmd, const std::string& what);
+  /// The profile with the overrides applied and validated; errors name the file or the key.
+  /// `extra` are KEY=VALUE pairs applied before `sets` (a subcommand's own options).
+  Expected<PrintConfig> load(const std::vector<std::string>& extra = {}) const;
+};
+
+/// Applies "KEY=VALUE" to c; the error names the key ("--set: …" for a malformed pair).
+Expected<std::pair<std::string, std::string>> apply_setting(PrintConfig& c, const std::string& kv);
 
 /// The analysis stage's options (--max-angle, --tau, ...), added to a subcommand.
 void add_analysis_options(CLI::App& cmd, AnalysisParams& p);

@@ -9,6 +9,7 @@
 #include "commands.hpp"
 #include "nonplanar/deform.hpp"
 #include "nonplanar/layers.hpp"
+#include "nonplanar/pipeline.hpp"
 #include "nonplanar/surface_io.hpp"
 
 namespace nonplanar::cli {
@@ -16,17 +17,49 @@ namespace {
 
 struct LayersOptions {
   MeshOptions mesh;
+  ProfileOptions profile;
   AnalysisParams analysis;
   FitParams fit;
-  LayerParams layers;
+  LayerParams tuning;  ///< the optimiser's settings (the limits come from the profile)
+  // Profile keys as options: layer_height, first_layer_height, max_layer_height,
+  // heater_block_radius, heater_block_clearance.
+  std::string keyed[5];
   bool json = false;
   std::string export_layers, export_normalized, section, at;
 };
 
-int run(LayersOptions o) {
-  // One printer angle and one minimum height serve facet selection and the stacks alike.
-  o.layers.max_angle_deg = o.analysis.max_angle_deg;
-  o.layers.min_layer_height = o.analysis.min_layer_height;
+// The job `slice` would run with the same profile (make_job), the optimiser tuned as asked.
+Expected<SliceJob> layers_job(const LayersOptions& o) {
+  static const char* keys[] = {"layer_height", "first_layer_height", "max_layer_height",
+                               "heater_block_radius", "heater_block_clearance"};
+  std::vector<std::string> extra;
+  for (std::size_t i = 0; i < std::size(keys); ++i)
+    if (!o.keyed[i].empty()) extra.push_back(std::string(keys[i]) + "=" + o.keyed[i]);
+  auto cfg = o.profile.load(extra);
+  if (!cfg) return cfg.error();
+  // --min-layer-height is the profile's min_layer_height unless the profile sets one.
+  if (cfg->min_layer_height == 0)
+    cfg->min_layer_height = std::min(o.analysis.min_layer_height, cfg->slice.layer_height);
+  if (!(o.analysis.max_angle_deg > 0 && o.analysis.max_angle_deg < 90))
+    return Error{Status::invalid_argument, "max_angle: must be in (0, 90) degrees"};
+  SliceJob job = make_job(*cfg, o.analysis.max_angle_deg);
+  AnalysisParams a = o.analysis;
+  a.max_angle_deg = job.analysis.max_angle_deg;
+  a.min_layer_height = job.analysis.min_layer_height;
+  job.analysis = a;
+  job.fit = o.fit;
+  job.layers.continuity_weight = o.tuning.continuity_weight;
+  job.layers.optimizer = o.tuning.optimizer;
+  job.layers.max_iterations = o.tuning.max_iterations;
+  return job;
+}
+
+int run(const LayersOptions& o) {
+  auto job = layers_job(o);
+  if (!job) return report_error(job.error());
+  const LayerParams& lp = job->layers;
+  if (!o.mesh.quiet && !o.json)
+    for (const std::string& n : job->notices) std::fprintf(stderr, "notice: %s\n", n.c_str());
   char axis = 0;
   double at = 0;
   if (!o.section.empty()) {
@@ -41,14 +74,16 @@ int run(LayersOptions o) {
     axis = o.at[0];
   }
   Context ctx = make_context(o.mesh.quiet || o.json);
-  auto loaded = load_mesh(o.mesh.model, o.mesh.load, ctx);
+  LoadParams load = o.mesh.load;
+  load.bed_center = job->print.bed_center();
+  auto loaded = load_mesh(o.mesh.model, load, ctx);
   if (!loaded) return finish_progress(), report_error(loaded.error());
-  auto analysis = analyze(loaded->mesh, o.analysis, ctx);
+  auto analysis = analyze(loaded->mesh, job->analysis, ctx);
   if (!analysis) return finish_progress(), report_error(analysis.error());
   std::vector<int> ids;
-  auto fits = fit_patches(loaded->mesh, *analysis, o.fit, {}, &ids, ctx);
+  auto fits = fit_patches(loaded->mesh, *analysis, job->fit, {}, &ids, ctx);
   if (!fits) return finish_progress(), report_error(fits.error());
-  auto plan = plan_layers(loaded->mesh, *analysis, *fits, ids, o.layers, ctx);
+  auto plan = plan_layers(loaded->mesh, *analysis, *fits, ids, lp, ctx);
   if (!plan) return finish_progress(), report_error(plan.error());
   std::size_t split = 0;
   if (!o.export_normalized.empty()) {
@@ -82,13 +117,13 @@ int run(LayersOptions o) {
   if (o.json) {
     nlohmann::ordered_json j;
     j["file"] = o.mesh.model;
-    j["params"] = {{"layer_height", o.layers.layer_height},
-                   {"first_layer_height", o.layers.first_layer_height},
-                   {"min_layer_height", o.layers.min_layer_height},
-                   {"max_layer_height", o.layers.max_layer_height},
-                   {"max_angle", o.layers.max_angle_deg},
-                   {"block_radius", o.layers.block_radius},
-                   {"block_clearance", o.layers.block_clearance}};
+    j["params"] = {{"layer_height", lp.layer_height},
+                   {"first_layer_height", lp.first_layer_height},
+                   {"min_layer_height", lp.min_layer_height},
+                   {"max_layer_height", lp.max_layer_height},
+                   {"max_angle", lp.max_angle_deg},
+                   {"head_reach", lp.toolhead.reach()},
+                   {"head_clearance", lp.toolhead.clearance()}};
     nlohmann::ordered_json stacks = nlohmann::ordered_json::array();
     for (const LayerStack& st : plan->stacks)
       stacks.push_back({{"patch", st.patch},
@@ -108,7 +143,7 @@ int run(LayersOptions o) {
     j["planar_fallbacks"] = std::move(fb);
     if (!o.export_normalized.empty()) j["normalized_edges_split"] = split;
     if (plan->stacks.empty()) {
-      const ShellSummary sh = summarize_shell(loaded->mesh, *analysis, o.layers);
+      const ShellSummary sh = summarize_shell(loaded->mesh, *analysis, lp);
       if (!sh.patches.empty())
         j["shell"] = {{"patches", sh.patches},
                       {"layers", sh.layers},
@@ -133,7 +168,7 @@ int run(LayersOptions o) {
     std::printf("  patch %d planar: %s\n", f.patch, f.reason.c_str());
   if (plan->stacks.empty()) {
     // What `slice` does then (it also runs the safety check on the result).
-    const ShellSummary sh = summarize_shell(loaded->mesh, *analysis, o.layers);
+    const ShellSummary sh = summarize_shell(loaded->mesh, *analysis, lp);
     std::string list;
     for (int p : sh.patches) list += (list.empty() ? "" : ", ") + std::to_string(p);
     if (!sh.patches.empty())
@@ -158,17 +193,16 @@ void register_layers(CLI::App& app, std::function<int()>* run_fn) {
       "would break a printer limit stay planar, with the reason.");
   opts->mesh.add_to(*cmd);
   add_analysis_options(*cmd, opts->analysis);
-  LayerParams& l = opts->layers;
-  cmd->add_option("--layer-height", l.layer_height, "Layer height h (mm)")->capture_default_str();
-  cmd->add_option("--first-layer-height", l.first_layer_height, "First layer (mm)")
-      ->capture_default_str();
-  cmd->add_option("--max-layer-height", l.max_layer_height, "Thickest curved layer (mm)")
-      ->capture_default_str();
-  cmd->add_option("--block-radius", l.block_radius, "Heater block radius around the nozzle (mm)")
-      ->capture_default_str();
-  cmd->add_option("--block-clearance", l.block_clearance,
-                  "Heater block bottom above the nozzle tip (mm)")
-      ->capture_default_str();
+  opts->profile.add_to(*cmd, "layer heights, limits, the toolhead; as `slice` reads it");
+  LayerParams& l = opts->tuning;
+  cmd->add_option("--layer-height", opts->keyed[0], "Layer height h (mm; default 0.2)");
+  cmd->add_option("--first-layer-height", opts->keyed[1], "First layer (mm)");
+  cmd->add_option("--max-layer-height", opts->keyed[2],
+                  "Thickest curved layer (mm; default automatic, as `slice`)");
+  cmd->add_option("--block-radius", opts->keyed[3],
+                  "Heater block radius around the nozzle (mm; = heater_block_radius)");
+  cmd->add_option("--block-clearance", opts->keyed[4],
+                  "Heater block bottom above the nozzle tip (mm; = heater_block_clearance)");
   cmd->add_option("--continuity-weight", l.continuity_weight, "lambda of the paper's eq. (1)")
       ->capture_default_str();
   const std::map<std::string, StackOptimizer> opt = {{"lbfgs", StackOptimizer::lbfgs},

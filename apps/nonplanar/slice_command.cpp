@@ -44,24 +44,15 @@ int run(const SliceOptions& o) {
     if (!c) return report_error(c.error());
     cfg = std::move(*c);
   }
-  auto apply = [&](const std::string& key, const std::string& value) -> int {
-    auto r = set_config_value(cfg, key, value);
-    if (!r) return report_error({Status::invalid_argument, "--" + r.error().message});
-    if (!*r) return report_error({Status::invalid_argument, "unknown setting '" + key + "'"});
-    return 0;
-  };
+  // Overrides in order: the named options, then --set. The engine gets its own keys only.
+  std::vector<std::string> overrides;
   for (const auto& [key, value] : o.named)
-    if (!value->empty()) {
-      if (int rc = apply(key, *value)) return rc;
-      engine.overrides.emplace_back(key, *value);
-    }
-  for (const std::string& kv : o.sets) {
-    const auto eq = kv.find('=');
-    if (eq == std::string::npos)
-      return report_error(
-          {Status::invalid_argument, "--set: expected KEY=VALUE, got '" + kv + "'"});
-    if (int rc = apply(kv.substr(0, eq), kv.substr(eq + 1))) return rc;
-    engine.overrides.emplace_back(kv.substr(0, eq), kv.substr(eq + 1));
+    if (!value->empty()) overrides.push_back(key + "=" + *value);
+  overrides.insert(overrides.end(), o.sets.begin(), o.sets.end());
+  for (const std::string& kv : overrides) {
+    auto applied = apply_setting(cfg, kv);
+    if (!applied) return report_error(applied.error());
+    if (!is_nonplanar_key(applied->first)) engine.overrides.push_back(std::move(*applied));
   }
   if (auto v = validate_config(cfg); !v) return report_error(v.error());
   if (!(o.max_angle > 0 && o.max_angle < 90))  // also catches NaN
@@ -174,7 +165,9 @@ void register_slice(CLI::App& app, std::function<int()>* run_fn) {
     cmd->add_option(flag, o->values[i], keys[i][1]);
     o->named.emplace_back(keys[i][0], &o->values[i]);
   }
-  cmd->add_option("--set", o->sets, "Any setting by its PrusaSlicer key: --set KEY=VALUE");
+  cmd->add_option("--set", o->sets,
+                  "Any setting by its key: --set KEY=VALUE (PrusaSlicer's keys, and the\n"
+                  "toolhead's: nozzle_cone_angle, toolhead_shape, ...; docs/toolhead.md)");
   *run_fn = nullptr;
   cmd->callback([o, run_fn] { *run_fn = [o] { return run(*o); }; });
 }

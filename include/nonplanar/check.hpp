@@ -10,6 +10,7 @@
 #include "nonplanar/config.hpp"
 #include "nonplanar/context.hpp"
 #include "nonplanar/mesh.hpp"
+#include "nonplanar/toolhead.hpp"
 #include "nonplanar/toolpaths.hpp"
 
 namespace nonplanar {
@@ -41,9 +42,7 @@ std::vector<PrintMove> moves_from_toolpaths(
 struct CheckParams {
   double max_angle_deg = 30;
   double layer_height = 0.2;  ///< h: a collision is a penetration deeper than h / 2
-  double nozzle_tip_radius = 0.4;
-  double nozzle_angle_deg = 45;
-  double block_radius = 8, block_clearance = 4;
+  Toolhead toolhead;          ///< what may not touch earlier material (toolhead.hpp)
   double filament_diameter = 1.75;
   double surface_samples_per_mm2 = 2;
   /// Only steepest extrusion and collisions (the slicer's safety gate, which measures
@@ -72,6 +71,10 @@ struct CheckFigures {
   double outside_fraction = 0;         ///< extrusion points outside the mesh (skirt excluded)
   std::size_t extrusions = 0;
 };
+
+/// The check's settings for a print made with `print` (layer height, filament, toolhead) and
+/// facets up to `max_angle_deg` printable: the gate and `check` build them alike.
+CheckParams check_params(const PrintConfig& print, double max_angle_deg);
 
 /// Computes the figures; `mesh` (placed like the G-code) may be null, then deviation,
 /// volume ratio and outside fraction are left at 0. Errors: cancelled.

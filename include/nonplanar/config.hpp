@@ -9,6 +9,7 @@
 
 #include "nonplanar/mesh.hpp"
 #include "nonplanar/status.hpp"
+#include "nonplanar/toolhead.hpp"
 
 namespace nonplanar {
 
@@ -72,6 +73,7 @@ struct PrintConfig {
   SliceParams slice;
   ToolpathParams paths;
   GcodeParams gcode;
+  Toolhead toolhead;  ///< nozzle cone, heater block, the rest of the head (toolhead.hpp)
   std::vector<std::string> notes;  ///< settings that were read but adapted (shown as warnings)
   Vec2 bed_center() const { return 0.5 * (bed_min + bed_max); }
 };
@@ -80,6 +82,16 @@ struct PrintConfig {
 /// "bed_shape" = "0x0,220x0,220x220,0x220", "gcode_flavor" = "marlin2"). Unknown keys are
 /// ignored (returns false); a bad value is an invalid_argument error naming the key.
 Expected<bool> set_config_value(PrintConfig& c, const std::string& key, const std::string& value);
+
+/// A head shape (docs/toolhead.md): JSON text, or a file. `toolhead_shape` in a profile names a
+/// file, or a head shipped in toolheads/ by its name (`prusa-mk3s`). Errors name the problem
+/// (and the file).
+Expected<std::vector<ToolheadSlice>> parse_toolhead_shape(std::string_view json);
+Expected<std::vector<ToolheadSlice>> load_toolhead_shape(const std::string& file_or_name);
+
+/// Is `key` one of ours rather than PrusaSlicer's (the toolhead's keys)? Such keys are not
+/// passed on to another slicer.
+bool is_nonplanar_key(const std::string& key);
 
 /// Checks ranges (finite, positive heights, density in [0, 1], ...). Error names the key.
 Expected<bool> validate_config(const PrintConfig& c);

@@ -15,6 +15,7 @@
 
 #include "nonplanar/analysis.hpp"
 #include "nonplanar/fit.hpp"
+#include "nonplanar/toolhead.hpp"
 
 namespace nonplanar {
 
@@ -27,10 +28,9 @@ struct LayerParams {
   double min_layer_height = 0.1;    ///< h_min
   double max_layer_height = 0.3;    ///< h_max
   double max_angle_deg = 30.0;      ///< steepest layer the nozzle cone allows
-  double nozzle_tip_radius = 0.4;   ///< flat of the nozzle tip
-  double nozzle_angle_deg = 45.0;   ///< nozzle wall above horizontal
-  double block_radius = 8.0;        ///< heater block, from the nozzle axis
-  double block_clearance = 4.0;     ///< heater block bottom above the nozzle tip
+  /// The head: within its reach() no point of a layer may rise more than its clearance()
+  /// above the nozzle tip, and the tip's flat sets how deep the steepest layers start.
+  Toolhead toolhead;
   double continuity_weight = 0.05;  ///< λ of eq. (1)
   StackOptimizer optimizer = StackOptimizer::lbfgs;
   int max_iterations = 100;

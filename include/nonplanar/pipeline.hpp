@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "nonplanar/check.hpp"
+#include "nonplanar/deform.hpp"
 #include "nonplanar/layers.hpp"
 
 namespace nonplanar {
@@ -26,7 +27,10 @@ struct EngineParams {
 struct SliceJob {
   AnalysisParams analysis;
   FitParams fit;
-  LayerParams layers;  ///< layer heights and printer limits; set from print by make_job
+  LayerParams layers;      ///< layer heights and printer limits; set from print by make_job
+  MapBackParams map_back;  ///< mapping paths and another engine's G-code back; by make_job
+  CheckParams check;       ///< the safety gate's limits and head; set by make_job
+  std::vector<std::string> notices;  ///< what make_job adapted (passed on to the result)
   PrintConfig print;
   bool planar_only = false;
   /// Another slicer instead of the built-in engine: it slices the normalised mesh with the
@@ -35,7 +39,9 @@ struct SliceJob {
   EngineParams engine;
 };
 
-/// A job whose layer and check settings agree with the print configuration.
+/// A job whose layer and check settings agree with the print configuration: heights, the
+/// toolhead, and a slope limit no steeper than the nozzle's cone (max_angle is lowered to
+/// nozzle_cone_angle when the cone is flatter, with a notice).
 SliceJob make_job(const PrintConfig& print, double max_angle_deg = 30.0);
 
 struct SliceResult {

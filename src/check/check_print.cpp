@@ -200,20 +200,14 @@ class Deposit {
   // Does earlier layers' material enter the nozzle at p deeper than `depth`? A block (64 × 64
   // cells, then 16 × 16, then 4 × 4) is skipped unless its highest point clears the smallest
   // allowance anywhere in it (the cone at the block's nearest distance, or the heater block).
-  bool collides(const Vec3& p, int layer, const CheckParams& cp, double tan_a, double depth) const {
+  bool collides(const Vec3& p, int layer, const HeadClearance& head, double depth) const {
     // Nothing deposited reaches above p: no allowance can be negative, so no collision.
     // (Every layer printed above all earlier material, i.e. most of any part, stops here.)
     const double top = layer == top_layer_ ? top_earlier_ : std::max(top_earlier_, top_current_);
     if (top <= p.z() + depth) return false;
-    const Query q{p,
-                  layer,
-                  cp,
-                  tan_a,
-                  depth,
-                  ix(p.x() - cp.block_radius),
-                  ix(p.x() + cp.block_radius),
-                  iy(p.y() - cp.block_radius),
-                  iy(p.y() + cp.block_radius)};
+    const double R = head.reach();
+    const Query q{
+        p, layer, head, depth, ix(p.x() - R), ix(p.x() + R), iy(p.y() - R), iy(p.y() + R)};
     return search(q, 0, std::max(0, q.i0 / kSize[0]), std::min(lx_[0] - 1, q.i1 / kSize[0]),
                   std::max(0, q.j0 / kSize[0]), std::min(ly_[0] - 1, q.j1 / kSize[0]));
   }
@@ -228,8 +222,8 @@ class Deposit {
   struct Query {
     const Vec3& p;
     int layer;
-    const CheckParams& cp;
-    double tan_a, depth;
+    const HeadClearance& head;
+    double depth;
     int i0, i1, j0, j1;  ///< cell range within the block radius
   };
   static void add(Cell& c, double z, int layer) {
@@ -244,7 +238,7 @@ class Deposit {
   }
   // Blocks [bi0, bi1] × [bj0, bj1] of level l (l = kLevels: cells).
   bool search(const Query& q, int l, int bi0, int bi1, int bj0, int bj1) const {
-    const double R = q.cp.block_radius;
+    const double R = q.head.reach();
     for (int bi = bi0; bi <= bi1; ++bi)
       for (int bj = bj0; bj <= bj1; ++bj) {
         if (l == kLevels) {
@@ -254,18 +248,17 @@ class Deposit {
                        ey = lo_.y() + (bj + 0.5) * cell_ - q.p.y();
           const double d2 = ex * ex + ey * ey;
           if (d2 > R * R) continue;
-          const double cone = std::max(0.0, std::sqrt(d2) - q.cp.nozzle_tip_radius) * q.tan_a;
-          if (z - q.p.z() - std::min(cone, q.cp.block_clearance) > q.depth) return true;
+          if (z - q.p.z() - q.head.allowance(Vec2(ex, ey)) > q.depth) return true;
           continue;
         }
         const int n = kSize[l];
         const double bx0 = lo_.x() + bi * n * cell_, by0 = lo_.y() + bj * n * cell_;
         const double dx = std::max({bx0 - q.p.x(), 0.0, q.p.x() - (bx0 + n * cell_)});
         const double dy = std::max({by0 - q.p.y(), 0.0, q.p.y() - (by0 + n * cell_)});
-        const double dmin = std::sqrt(dx * dx + dy * dy);
-        if (dmin > R) continue;
-        const double allow =
-            std::min(std::max(0.0, dmin - q.cp.nozzle_tip_radius) * q.tan_a, q.cp.block_clearance);
+        if (dx * dx + dy * dy > R * R) continue;
+        const double allow = q.head.allowance_lower_bound(
+            Vec2(bx0 - q.p.x(), by0 - q.p.y()),
+            Vec2(bx0 + n * cell_ - q.p.x(), by0 + n * cell_ - q.p.y()));
         const Cell& c = level_[l][static_cast<std::size_t>(bi) * ly_[l] + bj];
         if (earlier_z(c, q.layer) <= q.p.z() + q.depth + allow) continue;
         // The finer level's blocks (or the cells) inside this one, within the radius.
@@ -296,10 +289,18 @@ class Deposit {
 
 }  // namespace
 
+CheckParams check_params(const PrintConfig& print, double max_angle_deg) {
+  CheckParams cp;
+  cp.max_angle_deg = max_angle_deg;
+  cp.layer_height = print.slice.layer_height;
+  cp.filament_diameter = print.gcode.filament_diameter;
+  cp.toolhead = print.toolhead;
+  return cp;
+}
+
 Expected<CheckFigures> check_print(const std::vector<PrintMove>& moves, const TriangleMesh* mesh,
                                    const CheckParams& cp, const Context& ctx) {
   CheckFigures f;
-  const double tan_a = std::tan(cp.nozzle_angle_deg * M_PI / 180.0);
   auto counts = [](const PrintMove& m) {
     return m.extruding && m.layer >= 0 && m.type != "Skirt/Brim";
   };
@@ -384,8 +385,15 @@ Expected<CheckFigures> check_print(const std::vector<PrintMove>& moves, const Tr
       if (z.contains(p)) return true;
     return false;
   };
-  Deposit dep(lo - Vec2(cp.block_radius + 1, cp.block_radius + 1),
-              hi + Vec2(cp.block_radius + 1, cp.block_radius + 1), 0.2);
+  // Material stands at most the print's height above the nozzle: higher parts of the head
+  // (a gantry) are left out, which keeps the search radius that of the parts that can touch.
+  double z_lo = 1e300, z_hi = -1e300;
+  for (const PrintMove& m : moves)
+    if (m.extruding && m.layer >= 0)
+      z_lo = std::min({z_lo, m.from.z(), m.to.z()}), z_hi = std::max({z_hi, m.from.z(), m.to.z()});
+  const HeadClearance head(cp.toolhead, z_hi - z_lo);
+  const double margin = head.reach() + 1;
+  Deposit dep(lo - Vec2(margin, margin), hi + Vec2(margin, margin), 0.2);
   for (std::size_t mi = 0; mi < moves.size(); ++mi) {
     const PrintMove& m = moves[mi];
     if ((mi & 0xffff) == 0 && ctx.cancelled()) return Error{Status::cancelled, "cancelled"};
@@ -394,7 +402,7 @@ Expected<CheckFigures> check_print(const std::vector<PrintMove>& moves, const Tr
     const int n = std::max(1, static_cast<int>(std::ceil(len / 0.2)));
     for (int k = 1; k <= n; ++k) {
       const Vec3 p = m.from + (m.to - m.from) * (static_cast<double>(k) / n);
-      if (in_zone(p) && dep.collides(p, m.layer, cp, tan_a, 0.5 * cp.layer_height)) {
+      if (in_zone(p) && dep.collides(p, m.layer, head, 0.5 * cp.layer_height)) {
         if (f.collisions == 0) f.first_collision = p, f.first_collision_line = m.line;
         // Spread out (1 mm apart at least): one long collision must not fill the list.
         if (f.collision_points.size() < 4096 &&

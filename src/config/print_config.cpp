@@ -159,6 +159,21 @@ Expected<bool> set_config_value(PrintConfig& c, const std::string& key, const st
   }
   if (key == "start_gcode") return g.start_gcode = unescape(value), true;
   if (key == "end_gcode") return g.end_gcode = unescape(value), true;
+  Toolhead& head = c.toolhead;
+  if (key == "nozzle_tip_radius") return num(head.tip_radius);
+  if (key == "nozzle_cone_angle") return num(head.cone_angle_deg);
+  if (key == "heater_block_radius") return num(head.block_radius);
+  if (key == "heater_block_clearance") return num(head.block_clearance);
+  if (key == "toolhead_shape") {
+    std::string v = unescape(value);
+    v.erase(0, v.find_first_not_of(" \t"));
+    v.erase(v.find_last_not_of(" \t\r") + 1);
+    if (v.empty()) return head.shape.clear(), head.shape_name.clear(), true;  // the round head
+    auto shape = load_toolhead_shape(v);
+    if (!shape) return bad(key, shape.error().message);
+    head.shape = std::move(*shape), head.shape_name = v;
+    return true;
+  }
   if (key == "bed_shape") {
     // "0x0,220x0,220x220,0x220": the bounding box of the corners.
     Vec2 lo(1e300, 1e300), hi(-1e300, -1e300);
@@ -182,6 +197,11 @@ Expected<bool> set_config_value(PrintConfig& c, const std::string& key, const st
     return true;
   }
   return false;
+}
+
+bool is_nonplanar_key(const std::string& key) {
+  return key == "nozzle_tip_radius" || key == "nozzle_cone_angle" || key == "heater_block_radius" ||
+         key == "heater_block_clearance" || key == "toolhead_shape";
 }
 
 Expected<bool> validate_config(const PrintConfig& c) {
@@ -235,6 +255,15 @@ Expected<bool> validate_config(const PrintConfig& c) {
                              {"retract_lift", g.retract_lift},
                              {"skirt_distance", t.skirt_distance}})
     if (!std::isfinite(v) || v < 0) return bad(k, "must be a finite number >= 0");
+  const Toolhead& h = c.toolhead;
+  if (!pos(h.tip_radius) || h.tip_radius > 5)
+    return bad("nozzle_tip_radius", "must be in (0, 5] mm");
+  if (!(h.cone_angle_deg >= 5 && h.cone_angle_deg <= 85))
+    return bad("nozzle_cone_angle", "must be 5 to 85 degrees above horizontal");
+  if (!pos(h.block_radius) || h.block_radius > 200 || h.block_radius <= h.tip_radius)
+    return bad("heater_block_radius", "must be above nozzle_tip_radius and at most 200 mm");
+  if (!pos(h.block_clearance) || h.block_clearance > 200)
+    return bad("heater_block_clearance", "must be in (0, 200] mm");
   if (!c.bed_min.allFinite() || !c.bed_max.allFinite() || !(c.bed_max.x() > c.bed_min.x()) ||
       !(c.bed_max.y() > c.bed_min.y()))
     return bad("bed_shape", "is empty");

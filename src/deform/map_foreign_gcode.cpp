@@ -24,7 +24,6 @@
 namespace nonplanar {
 namespace {
 
-constexpr double kTipRadius = 0.4;  // the writer's short-hop reach (gcode_writer.cpp)
 constexpr double kNone = std::numeric_limits<double>::quiet_NaN();
 
 struct Move {
@@ -657,14 +656,12 @@ Expected<ForeignGcode> map_foreign_gcode(std::string_view text, const LayerField
           target.p.z() != m.to.z() || !field.planar_at(m.from.x(), m.from.y()) ||
           !field.planar_along(m.from.head<2>(), m.to.head<2>(), field.t_of_zeta(m.to.z() - m.h),
                               field.t_of_zeta(m.to.z()));
-      const double d = (to - at).head<2>().norm();
-      const double hop = L.max_slope * (0.5 * d + kTipRadius);
       const double de = m.has_e ? m.de + pending : kNone;
       if (m.has_e) retracted -= m.de, pending = 0;
-      if (curved && m.has_xy && (d > 0.6 || std::abs(to.z() - at.z()) > 0.1 || hop > 0.05)) {
-        const double lift = d > 0.6 || std::abs(to.z() - at.z()) > 0.1
-                                ? std::max({L.max_z, at.z(), to.z()}) + 0.3
-                                : std::max(at.z(), to.z()) + hop + 0.05;
+      const double lift = curved && m.has_xy ? travel_height(at, to, L.max_z, L.max_slope,
+                                                             params.tip_radius, params.travel_lift)
+                                             : kNone;
+      if (!std::isnan(lift)) {
         const Vec3 up(at.x(), at.y(), lift), over(to.x(), to.y(), lift);
         w.move(up, at, kNone, m.f);
         w.move(over, up, kNone, kNone);

@@ -89,7 +89,7 @@ Expected<EngineShell> shell_with_engine(const TriangleMesh& mesh, const layers::
   ForeignMapOptions core_opt;
   core_opt.clip = &clip;
   const auto planar = planar_field(job.layers);
-  auto core = map_foreign_gcode(*core_text, *planar, {}, ctx, core_opt);
+  auto core = map_foreign_gcode(*core_text, *planar, job.map_back, ctx, core_opt);
   if (!core) {
     Error e = core.error();
     e.message = "engine G-code (core), " + e.message;
@@ -124,7 +124,7 @@ Expected<EngineShell> shell_with_engine(const TriangleMesh& mesh, const layers::
   ForeignMapOptions shell_opt;
   shell_opt.start = core->end_at;
   shell_opt.start_retracted = core->retracted;
-  auto shell = map_foreign_gcode(*shell_text, path_field, {}, ctx, shell_opt);
+  auto shell = map_foreign_gcode(*shell_text, path_field, job.map_back, ctx, shell_opt);
   if (!shell) {
     Error e = shell.error();
     e.message = "engine G-code (shell), " + e.message;

@@ -31,6 +31,22 @@ SliceJob make_job(const PrintConfig& print, double max_angle_deg) {
                                   : std::max(1.5 * print.slice.layer_height,
                                              std::min(0.75 * print.paths.nozzle_diameter, 0.3));
   j.analysis.min_layer_height = j.layers.min_layer_height;
+  // A layer steeper than the nozzle's outer wall drags the wall through the layer under it
+  // (DESIGN.md §3): the cone bounds the slope, for the facets painted and the layers alike.
+  const double cone = print.toolhead.cone_angle_deg;
+  if (cone < max_angle_deg) {
+    char buf[160];
+    std::snprintf(buf, sizeof buf,
+                  "max_angle lowered from %.1f to %.1f deg: the nozzle's cone "
+                  "(nozzle_cone_angle) is no steeper",
+                  max_angle_deg, cone);
+    j.notices.emplace_back(buf);
+    j.analysis.max_angle_deg = j.layers.max_angle_deg = cone;
+  }
+  j.layers.toolhead = print.toolhead;
+  j.map_back.tip_radius = print.toolhead.tip_radius;
+  j.map_back.travel_lift = std::max(0.3, print.gcode.retract_lift);
+  j.check = check_params(print, j.layers.max_angle_deg);
   return j;
 }
 
@@ -76,18 +92,11 @@ Expected<bool> gate(SliceResult& r, const SliceJob& job, const layers::BandedFie
   if (!r.nonplanar) return true;  // planar layers cannot dig into earlier ones
   // Collisions are looked for even when bands already broke a limit, so one retry drops
   // every offender (each retry replans, reslices and rechecks the whole part).
-  CheckParams cp;
-  cp.max_angle_deg = L.max_angle_deg;
-  cp.layer_height = L.layer_height;
-  cp.nozzle_tip_radius = L.nozzle_tip_radius;
-  cp.nozzle_angle_deg = L.nozzle_angle_deg;
-  cp.block_radius = L.block_radius;
-  cp.block_clearance = L.block_clearance;
-  cp.filament_diameter = job.print.gcode.filament_diameter;
+  CheckParams cp = job.check;
   cp.collisions_only = true;
-  // Only where a curved layer is within the heater block's reach (gate_zones.hpp): on the
-  // bunny that skipped most of 24 million extrusion samples.
-  GateZones zones = banded ? gate_zones(*banded, cp.block_radius) : GateZones{};
+  // Only where a curved layer is within the head's reach (gate_zones.hpp): on the bunny that
+  // skipped most of 24 million extrusion samples.
+  GateZones zones = banded ? gate_zones(*banded, cp.toolhead.reach()) : GateZones{};
   zones.find_last_layers(r.layers);
   cp.collision_zones = zones.query;
   auto figures = check_print(moves_from_toolpaths(r.layers, job.print.gcode,
@@ -128,7 +137,7 @@ Expected<bool> slice_with_engine(const TriangleMesh& to_slice, const SliceJob& j
   if (!text) return text.error();
   const auto planar = planar_field(job.layers);
   const LayerField& field = r.nonplanar ? *r.plan.field : *planar;
-  auto mapped = map_foreign_gcode(*text, field, {}, ctx);
+  auto mapped = map_foreign_gcode(*text, field, job.map_back, ctx);
   if (!mapped) {
     Error e = mapped.error();
     e.message = "engine G-code, " + e.message;
@@ -165,6 +174,7 @@ Expected<SliceResult> attempt(const TriangleMesh& mesh, const SliceJob& job, con
         buf, sizeof buf, "curved layers: h_min %.3f mm, h_max %.3f mm, max_angle %.1f deg",
         job.layers.min_layer_height, job.layers.max_layer_height, job.layers.max_angle_deg);
     r.header.push_back(buf);
+    r.header.push_back("toolhead: " + job.layers.toolhead.describe());
   }
   const TriangleMesh* to_slice = &mesh;
   TriangleMesh normalized;
@@ -213,7 +223,7 @@ Expected<SliceResult> attempt(const TriangleMesh& mesh, const SliceJob& job, con
     if (!r.nonplanar) {
       r.layers = std::move(*paths);
     } else {
-      auto mapped = map_toolpaths_back(*paths, *r.plan.field, {}, ctx);
+      auto mapped = map_toolpaths_back(*paths, *r.plan.field, job.map_back, ctx);
       if (!mapped) return mapped.error();
       r.layers = std::move(*mapped);
     }
@@ -341,8 +351,11 @@ Expected<std::optional<SliceResult>> try_shell(const TriangleMesh& mesh, const S
 
 }  // namespace
 
-Expected<SliceResult> slice_model(const TriangleMesh& mesh, const SliceJob& job,
-                                  const Context& ctx) {
+namespace {
+
+// slice_model's rounds: attempts, retries without the patches that broke a limit, shells.
+Expected<SliceResult> slice_rounds(const TriangleMesh& mesh, const SliceJob& job,
+                                   const Context& ctx) {
   Prepared pre;
   if (!job.planar_only) {
     auto a = analyze(mesh, job.analysis, ctx);
@@ -394,6 +407,15 @@ Expected<SliceResult> slice_model(const TriangleMesh& mesh, const SliceJob& job,
     }
   }
   return Error{Status::internal_error, "safety check: still failing after dropping 8 patches"};
+}
+
+}  // namespace
+
+Expected<SliceResult> slice_model(const TriangleMesh& mesh, const SliceJob& job,
+                                  const Context& ctx) {
+  auto r = slice_rounds(mesh, job, ctx);
+  if (r) r->notices.insert(r->notices.begin(), job.notices.begin(), job.notices.end());
+  return r;
 }
 
 }  // namespace nonplanar

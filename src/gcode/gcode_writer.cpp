@@ -19,9 +19,6 @@ double filament_per_mm(double width, double height, const GcodeParams& g) {
 }
 
 namespace {
-// Radius of the nozzle's flat tip (LayerParams::nozzle_tip_radius): what a hop must clear.
-constexpr double kTipRadius = 0.4;
-
 const char* flavor_name(GcodeFlavor f) {
   switch (f) {
     case GcodeFlavor::marlin2:
@@ -65,7 +62,7 @@ std::string expand(std::string t, const PrintConfig& c) {
 
 class Emitter {
  public:
-  explicit Emitter(const PrintConfig& c) : g_(c.gcode) {}
+  explicit Emitter(const PrintConfig& c) : g_(c.gcode), tip_radius_(c.toolhead.tip_radius) {}
   std::string out;
 
   void raw(const std::string& s) { out += s; }
@@ -99,25 +96,16 @@ class Emitter {
     retracted_ = false;
   }
   // Travel to p: lift and retract for long moves, never through the part at print height.
-  // On a curved layer, material printed so far lies below the layer's highest point, so a
-  // travel rises above that (plus a clearance), moves, then descends.
-  //
-  // A short hop (≤ 0.6 mm, as between neighbouring infill lines) only rises above what the
-  // layer can hold within reach of it: the layer is no steeper than `slope`, so nothing of
-  // it within the nozzle's tip radius r of the hop stands higher than its ends by more than
-  // slope · (d / 2 + r). (Travelling at the ends' height went 0.12 mm under a neighbouring
-  // line on a wave; TravelsClearPrintedMaterial found it.)
+  // On a curved layer, as travel_height says (toolhead.hpp). (Travelling at the ends' height
+  // went 0.12 mm under a neighbouring line on a wave; TravelsClearPrintedMaterial found it.)
   void travel(const Vec3& p, double speed, bool curved, double safe_z, double slope) {
     if (curved && have_pos_) {
       const double d = (p.head<2>() - pos_.head<2>()).norm();
       if (d < 1e-6 && std::abs(p.z() - pos_.z()) < 1e-6) return;
-      const double hop = slope * (0.5 * d + kTipRadius);
-      if (d > 0.6 || std::abs(p.z() - pos_.z()) > 0.1 || hop > 0.05) {
+      const double lift =
+          travel_height(pos_, p, safe_z, slope, tip_radius_, std::max(0.3, g_.retract_lift));
+      if (!std::isnan(lift)) {
         if (d > g_.retract_before_travel) retract();
-        const double lift =
-            d > 0.6 || std::abs(p.z() - pos_.z()) > 0.1
-                ? std::max({safe_z, pos_.z(), p.z()}) + std::max(0.3, g_.retract_lift)
-                : std::max(pos_.z(), p.z()) + hop + 0.05;
         line("G1 Z%.3f F%d", lift, static_cast<int>(speed * 60));
         line("G1 X%.3f Y%.3f F%d", p.x(), p.y(), static_cast<int>(speed * 60));
         line("G1 Z%.3f F%d", p.z(), static_cast<int>(speed * 60));
@@ -165,6 +153,7 @@ class Emitter {
     line("G1 E%.5f F%d ; %s", g_.relative_e ? de : e_, static_cast<int>(speed * 60), what);
   }
   const GcodeParams& g_;
+  double tip_radius_;  ///< what a short hop must clear (travel_height)
   Vec3 pos_ = Vec3::Zero();
   bool have_pos_ = false, retracted_ = false;
   double e_ = 0;

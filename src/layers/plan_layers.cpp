@@ -34,10 +34,14 @@ std::optional<Error> check(const LayerParams& p) {
     return bad("layer_height", "must lie in [min_layer_height, max_layer_height]");
   if (!std::isfinite(p.max_angle_deg) || p.max_angle_deg <= 0 || p.max_angle_deg >= 90)
     return bad("max_angle", "must be in (0, 90) degrees");
-  if (!pos(p.block_radius) || !pos(p.block_clearance) || !pos(p.nozzle_tip_radius))
-    return bad("block_radius/block_clearance/nozzle_tip_radius", "must be finite numbers > 0");
-  if (!std::isfinite(p.nozzle_angle_deg) || p.nozzle_angle_deg <= 0 || p.nozzle_angle_deg >= 90)
-    return bad("nozzle_angle", "must be in (0, 90) degrees");
+  const Toolhead& h = p.toolhead;
+  if (!pos(h.block_radius) || !pos(h.block_clearance) || !pos(h.tip_radius))
+    return bad("heater_block_radius/heater_block_clearance/nozzle_tip_radius",
+               "must be finite numbers > 0");
+  if (!std::isfinite(h.cone_angle_deg) || h.cone_angle_deg <= 0 || h.cone_angle_deg >= 90)
+    return bad("nozzle_cone_angle", "must be in (0, 90) degrees");
+  if (!(h.clearance() > 0) || !std::isfinite(h.reach()))
+    return bad("toolhead_shape", "its lowest slice must be above the nozzle tip");
   if (!std::isfinite(p.continuity_weight) || p.continuity_weight < 0)
     return bad("continuity_weight", "must be >= 0");
   if (!pos(p.grid_step)) return bad("grid_step", "must be > 0");

@@ -62,8 +62,13 @@ class StackObjective final : public ceres::FirstOrderFunction {
   CostTerms c_;
 };
 
+constexpr double kNoLimit = 1e300;
+
 struct Figures {
-  double t_min = 1e300, t_max = -1e300, slope = 0, rise = 0;
+  double t_min = 1e300, t_max = -1e300, slope = 0;
+  // The pair of points of one layer that comes nearest the head (or goes furthest into it):
+  // how far q rises above p, what the head allows there, and the difference.
+  double rise = 0, rise_allow = kNoLimit, excess = -kNoLimit;
 };
 
 // Thickness and slope over the patch's samples; rise of each layer within the block radius
@@ -106,29 +111,55 @@ Figures measure(const StackGrid& g, const Eigen::MatrixXd& Z, const LayerParams&
       f.t_max = std::max(f.t_max, S[i][k] - S[i + 1][k]);
     }
   }
-  // Rise within the block radius, on a 2D subgrid of about 1 mm: for each patch point p,
-  // the highest point q of the same layer in the disk around it (precomputed offsets).
+  // Rise under the head, on a 2D subgrid of about 1 mm: for each patch point p, how far a
+  // point q of the same layer within the head's reach rises above what the head allows there
+  // (its block allowance at q − p; the cone is the slope limit's). Offsets are sorted by
+  // allowance, so the search stops at the first that layer's highest point cannot exceed.
   const int sx = std::max(1, static_cast<int>(std::lround(1.0 / g.step_x)));
   const int sy = std::max(1, static_cast<int>(std::lround(1.0 / g.step_y)));
-  std::vector<std::pair<int, int>> disk;
-  const int rx = static_cast<int>(p.block_radius / (sx * g.step_x));
-  const int ry = static_cast<int>(p.block_radius / (sy * g.step_y));
-  for (int di = -rx; di <= rx; ++di)
-    for (int dj = -ry; dj <= ry; ++dj)
-      if (std::hypot(di * sx * g.step_x, dj * sy * g.step_y) <= p.block_radius)
-        disk.emplace_back(di * sx, dj * sy);
+  // Layers rise no more than the stack's own height: parts of the head above it can't touch.
+  double s_lo = 1e300, s_hi = -1e300;
   for (int i = 0; i < L; ++i)
+    for (int k = 0; k < n; ++k)
+      if (g.on_patch[k]) s_lo = std::min(s_lo, S[i][k]), s_hi = std::max(s_hi, S[i][k]);
+  const HeadClearance head(p.toolhead, s_hi - s_lo);
+  struct Offset {
+    int di, dj;
+    double allow;
+  };
+  std::vector<Offset> disk;
+  const double R = head.reach();
+  const int rx = static_cast<int>(R / (sx * g.step_x));
+  const int ry = static_cast<int>(R / (sy * g.step_y));
+  for (int di = -rx; di <= rx; ++di)
+    for (int dj = -ry; dj <= ry; ++dj) {
+      const Vec2 d(di * sx * g.step_x, dj * sy * g.step_y);
+      const double a = d.norm() <= R ? head.block_allowance(d) : kNoLimit;
+      if (a < kNoLimit) disk.push_back({di * sx, dj * sy, a});
+    }
+  std::stable_sort(disk.begin(), disk.end(),
+                   [](const Offset& u, const Offset& v) { return u.allow < v.allow; });
+  f.excess = -1e300;
+  for (int i = 0; i < L; ++i) {
+    double top = -1e300;
+    for (int k = 0; k < n; ++k)
+      if (g.on_patch[k]) top = std::max(top, S[i][k]);
     for (int a = 0; a < g.nx; a += sx)
       for (int b = 0; b < g.ny; b += sy) {
         const int k = a * g.ny + b;
         if (!g.on_patch[k]) continue;
-        for (const auto& [di, dj] : disk) {
-          const int a2 = a + di, b2 = b + dj;
+        for (const Offset& o : disk) {
+          if (top - S[i][k] - o.allow <= f.excess) break;
+          const int a2 = a + o.di, b2 = b + o.dj;
           if (a2 < 0 || b2 < 0 || a2 >= g.nx || b2 >= g.ny) continue;
           const int k2 = a2 * g.ny + b2;
-          if (g.on_patch[k2]) f.rise = std::max(f.rise, S[i][k2] - S[i][k]);
+          if (!g.on_patch[k2]) continue;
+          const double rise = S[i][k2] - S[i][k];
+          if (rise - o.allow > f.excess)
+            f.excess = rise - o.allow, f.rise = rise, f.rise_allow = o.allow;
         }
       }
+  }
   return f;
 }
 
@@ -237,7 +268,7 @@ StackResult build_stack(const TriangleMesh& mesh, const Patch& patch, int patch_
     if (N < 1) return false;
     for (int kk = 0; kk < n; ++kk)
       if (grid.on_patch[kk] &&
-          (top_z[kk] - c) / N < (p.nozzle_tip_radius + 0.1) * top_tan[kk] - 0.5 * p.layer_height)
+          (top_z[kk] - c) / N < (p.toolhead.tip_radius + 0.1) * top_tan[kk] - 0.5 * p.layer_height)
         return false;
     return true;
   };
@@ -328,8 +359,10 @@ StackResult build_stack(const TriangleMesh& mesh, const Patch& patch, int patch_
                         p.continuity_weight,
                         1e5,
                         std::tan(p.max_angle_deg * kDeg) - 0.01,
-                        p.block_clearance - 0.05};
-  coarse.pair_within(p.block_radius, 2.0);
+                        p.toolhead.clearance() - 0.05};
+  // The cost's round stand-in for the head: its lowest part over the block's disk (the
+  // rise check below uses the whole shape).
+  coarse.pair_within(std::min(p.toolhead.block_radius, p.toolhead.reach()), 2.0);
   st.cost_before = printability_cost(coarse, Z, terms, nullptr);
   Eigen::MatrixXd best = Z;
   if (N >= 2 && p.max_iterations > 0) {
@@ -383,9 +416,9 @@ StackResult build_stack(const TriangleMesh& mesh, const Patch& patch, int patch_
     out.failure = fmt2("layer slope %.1f deg exceeds max_angle %.1f deg", f.slope, p.max_angle_deg);
     return out;
   }
-  if (f.rise > p.block_clearance) {
-    out.failure = fmt2("a layer rises %.2f mm within the heater block radius, clearance is %.2f mm",
-                       f.rise, p.block_clearance);
+  if (f.excess > 0) {
+    out.failure = fmt2("a layer rises %.2f mm where the head is %.2f mm above the nozzle tip",
+                       f.rise, f.rise_allow);
     return out;
   }
   for (int i = 0; i <= N; ++i) {

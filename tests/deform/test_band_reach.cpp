@@ -46,14 +46,14 @@ TEST(GateZones, FindEveryCollisionTheFullCheckFinds) {
 
   // A heater block 0.3 mm above the tip and a 10° cone: the dome's layers now collide.
   CheckParams cp;
-  cp.block_clearance = 0.3;
-  cp.nozzle_angle_deg = 10;
+  cp.toolhead.block_clearance = 0.3;
+  cp.toolhead.cone_angle_deg = 10;
   cp.collisions_only = true;
   const std::vector<PrintMove> all = moves_from_toolpaths(r->layers, c.gcode);
   auto full = check_print(all, nullptr, cp, {});
   ASSERT_TRUE(full);
 
-  GateZones zones = gate_zones(*field, cp.block_radius);
+  GateZones zones = gate_zones(*field, cp.toolhead.reach());
   zones.find_last_layers(r->layers);
   ASSERT_EQ(zones.query.size(), 1u);
   const std::vector<PrintMove> near = moves_from_toolpaths(

@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 
 #include "nonplanar/check.hpp"
 #include "nonplanar/io.hpp"
@@ -59,18 +60,25 @@ TEST(EnginePrusaSlicer, TheUsersProfileShowsInTheResult) {
   ASSERT_TRUE(write_stl(stl, test::saddle()));
   const std::string ini = std::string(NONPLANAR_TEST_DATA) + "/prusaslicer_015mm_215C.ini";
   const auto out = dir / "saddle.gcode";
+  // The head's keys are ours: used for planning, never handed to PrusaSlicer (which would
+  // refuse them).
   const auto r =
       test::run_cli("slice -q " + stl.string() + " --engine prusaslicer --engine-config " + ini +
-                    " -o " + out.string());
+                    " -o " + out.string() + " --set nozzle_cone_angle=20");
   ASSERT_EQ(r.code, 0) << r.err;
   const std::string g = test::read_bytes(out);
+  EXPECT_EQ(g.find("engine setting: nozzle_cone_angle"), std::string::npos);
+  EXPECT_NE(g.find("; toolhead: round (tip 0.40 mm, cone 20.0 deg"), std::string::npos);
   EXPECT_NE(g.find("M109 S215"), std::string::npos);  // the profile's temperature
   EXPECT_NE(g.find("; engine setting: layer_height = 0.15"), std::string::npos);
   EXPECT_NE(g.find("\n;Z:0.350\n"), std::string::npos);  // its 0.35 mm first layer ...
   EXPECT_NE(g.find("\n;Z:0.500\n"), std::string::npos);  // ... then 0.15 mm layers
   const auto chk = test::run_cli("check -q --json " + out.string() + " --mesh " + stl.string() +
-                                 " --config " + ini);
+                                 " --config " + ini + " --set nozzle_cone_angle=20");
   ASSERT_EQ(chk.code, 0) << chk.err;
+  const auto j = nlohmann::json::parse(chk.out);
+  EXPECT_EQ(j["collisions"], 0);
+  EXPECT_LE(j["steepest_extrusion"].get<double>(), 20.5);
 }
 
 // The wing's top runs from the bed to 17.5 mm: no stack fits, so PrusaSlicer prints the core

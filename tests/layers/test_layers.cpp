@@ -86,7 +86,7 @@ void expect_printable(const Planned& p, std::size_t stacks) {
     EXPECT_LE(t_hi, lp.max_layer_height + 1e-6);
     EXPECT_LE(worst_slope, tan_max * 1.01);  // finite differences of a 0.05 mm step
     EXPECT_LE(top_err, 0.001);               // the last layer lies on the mesh's facets
-    EXPECT_LE(st.max_block_rise, lp.block_clearance);
+    EXPECT_LE(st.max_block_rise, lp.toolhead.clearance());
     EXPECT_GT(st.layers, 3);
   }
 }
