@@ -130,6 +130,8 @@ void print_text(const AnalyzeOptions& o, const LoadedMesh& m, const Analysis& a)
 }
 
 int run(const AnalyzeOptions& o) {
+  if (auto c = check_outputs({o.mesh.model}, {o.export_patches}); !c)
+    return report_error(c.error());
   Context ctx = make_context(o.mesh.quiet || o.json);
   auto loaded = load_mesh(o.mesh.model, o.mesh.load, ctx);
   if (!loaded) {

@@ -3,8 +3,11 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <cerrno>
 #include <csignal>
 #include <cstdio>
+#include <cstring>
+#include <filesystem>
 
 #include "core/atomic_file.hpp"
 
@@ -49,7 +52,7 @@ void ProfileOptions::add_to(CLI::App& cmd, const std::string& what) {
   cmd.add_option("--config", config, "Profile: .json or PrusaSlicer .ini (" + what + ")");
   cmd.add_option("--set", sets,
                  "Any setting by its key, after the profile: --set KEY=VALUE (e.g.\n"
-                 "nozzle_cone_angle=40, toolhead_shape=prusa_mk3s; docs/toolhead.md)");
+                 "nozzle_cone_angle=40, toolhead_shape=prusa-mk3s; docs/toolhead.md)");
 }
 
 Expected<std::pair<std::string, std::string>> apply_setting(PrintConfig& c, const std::string& kv) {
@@ -94,6 +97,42 @@ void add_analysis_options(CLI::App& cmd, AnalysisParams& p) {
       ->capture_default_str();
   cmd.add_option("--min-patch-area", p.min_patch_area, "Smaller patches are dropped (mm^2)")
       ->capture_default_str();
+}
+
+namespace {
+// The same file: the same inode where both exist, else the same path once resolved.
+bool same_file(const std::string& a, const std::string& b) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (fs::exists(a, ec) && fs::exists(b, ec)) return fs::equivalent(a, b, ec) && !ec;
+  const fs::path ca = fs::weakly_canonical(a, ec);
+  if (ec) return false;
+  const fs::path cb = fs::weakly_canonical(b, ec);
+  return !ec && ca == cb;
+}
+}  // namespace
+
+Expected<bool> check_outputs(const std::vector<std::string>& inputs,
+                             const std::vector<std::string>& outputs) {
+  for (std::size_t i = 0; i < outputs.size(); ++i) {
+    if (outputs[i].empty()) continue;
+    for (const std::string& in : inputs)
+      if (!in.empty() && same_file(in, outputs[i]))
+        return Error{Status::invalid_argument,
+                     outputs[i] + ": is the input " + in + "; it would be overwritten"};
+    for (std::size_t j = 0; j < i; ++j)
+      if (!outputs[j].empty() && same_file(outputs[j], outputs[i]))
+        return Error{Status::invalid_argument,
+                     outputs[i] + ": is also " + outputs[j] + "; two outputs cannot share a file"};
+  }
+  return true;
+}
+
+bool flush_stdout() {
+  errno = 0;
+  if (std::fflush(stdout) == 0 && !std::ferror(stdout)) return true;
+  std::fprintf(stderr, "error: stdout: %s\n", errno ? std::strerror(errno) : "write failed");
+  return false;
 }
 
 int report_error(const Error& e) {

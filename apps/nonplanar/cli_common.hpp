@@ -51,6 +51,15 @@ Expected<std::pair<std::string, std::string>> apply_setting(PrintConfig& c, cons
 /// The analysis stage's options (--max-angle, --tau, ...), added to a subcommand.
 void add_analysis_options(CLI::App& cmd, AnalysisParams& p);
 
+/// Refuses to write any output over an input or over another output (the same file by any
+/// name: a link, "./x", an absolute path). Empty names are ignored. The error names both.
+Expected<bool> check_outputs(const std::vector<std::string>& inputs,
+                             const std::vector<std::string>& outputs);
+
+/// Flushes stdout; false (after printing "error: stdout: REASON") when what was printed did
+/// not all arrive (`> /dev/full`, a closed pipe).
+bool flush_stdout();
+
 /// Prints "error: MESSAGE" on stderr; returns the exit code for the status.
 int report_error(const Error& e);
 /// Prints "warning: FILE: MESSAGE" for each loader warning (unless quiet).

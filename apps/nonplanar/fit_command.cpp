@@ -23,6 +23,8 @@ struct FitOptions {
 };
 
 int run(FitOptions o) {
+  if (auto c = check_outputs({o.mesh.model}, {o.export_surfaces, o.export_mesh}); !c)
+    return report_error(c.error());
   if (o.fixed_weights) o.fit.free_weights = false;
   Context ctx = make_context(o.mesh.quiet || o.json);
   auto loaded = load_mesh(o.mesh.model, o.mesh.load, ctx);

@@ -55,6 +55,10 @@ Expected<SliceJob> layers_job(const LayersOptions& o) {
 }
 
 int run(const LayersOptions& o) {
+  if (auto c = check_outputs({o.mesh.model, o.profile.config},
+                             {o.export_layers, o.export_normalized, o.section});
+      !c)
+    return report_error(c.error());
   auto job = layers_job(o);
   if (!job) return report_error(job.error());
   const LayerParams& lp = job->layers;

@@ -29,7 +29,10 @@ int main(int argc, char** argv) {
   }
   install_interrupt_handler();
   try {
-    return run ? run() : kExitBadInput;
+    const int rc = run ? run() : kExitBadInput;
+    // Figures that never reached their reader are not a success (`check --json > /dev/full`).
+    if (!flush_stdout()) return rc == kExitOk ? kExitBadInput : rc;
+    return rc;
   } catch (const std::bad_alloc&) {
     std::fprintf(stderr, "error: out of memory\n");
   } catch (const std::exception& e) {

@@ -24,6 +24,10 @@ struct SliceOptions {
 };
 
 int run(const SliceOptions& o) {
+  if (auto c = check_outputs(
+          {o.mesh.model, o.config, o.engine_config, o.engine_filaments, o.engine_path}, {o.output});
+      !c)
+    return report_error(c.error());
   PrintConfig cfg;
   EngineParams engine;
   if (o.engine == "prusaslicer")

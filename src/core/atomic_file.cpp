@@ -1,9 +1,12 @@
 #include "core/atomic_file.hpp"
 
+#include <signal.h>
 #include <unistd.h>
 
 #include <atomic>
 #include <cerrno>
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <random>
@@ -26,42 +29,105 @@ struct PendingGuard {
   PendingGuard(const PendingGuard&) = delete;
   PendingGuard& operator=(const PendingGuard&) = delete;
 };
+
+// Temporaries are ".nonplanar-PID-XXXXXX.tmp": short whatever the output's name (a 255-byte
+// name must still work), and a later run can tell whose they are.
+constexpr char kPrefix[] = ".nonplanar-";
+constexpr char kSuffix[] = ".tmp";
+
+// Removes temporaries in `dir` left by runs that no longer exist (killed mid-write).
+void remove_stale_temporaries(const std::filesystem::path& dir) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    if (name.rfind(kPrefix, 0) != 0 || name.size() < sizeof kSuffix ||
+        name.compare(name.size() - 4, 4, kSuffix) != 0)
+      continue;
+    const std::string rest = name.substr(sizeof kPrefix - 1);
+    char* end_pid = nullptr;
+    const long pid = std::strtol(rest.c_str(), &end_pid, 10);
+    if (pid <= 0 || end_pid == rest.c_str() || *end_pid != '-') continue;
+    if (::kill(static_cast<pid_t>(pid), 0) == 0 || errno != ESRCH) continue;  // still running
+    std::error_code rm;
+    fs::remove(it->path(), rm);
+  }
+}
+
+// Writes straight into what `file` is when it is not a regular file (a device such as
+// /dev/null or /dev/stdout, a pipe): renaming over it would replace the device node.
+Expected<bool> write_in_place(const std::filesystem::path& file,
+                              const std::function<bool(std::ostream&)>& write) {
+  std::ofstream out(file, std::ios::binary);
+  if (!out)
+    return Error{Status::io_error, file.string() + ": cannot write: " + std::strerror(errno)};
+  errno = 0;
+  const bool ok = write(out) && out.flush().good();
+  if (!ok)
+    return Error{Status::io_error, file.string() + ": write failed" +
+                                       (errno ? std::string(": ") + std::strerror(errno) : "")};
+  return true;
+}
 }  // namespace
 
 void remove_pending_temporary_file() {
   if (g_pending_set.load()) ::unlink(g_pending);
 }
 
-Expected<bool> write_file_atomically(const std::filesystem::path& file,
+Expected<bool> write_file_atomically(const std::filesystem::path& file_in,
                                      const std::function<bool(std::ostream&)>& write) {
   namespace fs = std::filesystem;
-  const fs::path dir = file.has_parent_path() ? file.parent_path() : fs::path(".");
   std::error_code ec;
+  // A link is written through: the file it names is replaced, the link stays.
+  fs::path file = file_in;
+  if (fs::is_symlink(fs::symlink_status(file, ec))) {
+    const fs::path target = fs::weakly_canonical(file, ec);
+    if (!ec) file = target;
+  }
+  const fs::file_status st = fs::status(file, ec);
+  if (fs::exists(st)) {
+    if (fs::is_directory(st)) return Error{Status::io_error, file_in.string() + ": is a folder"};
+    if (fs::is_character_file(st) || fs::is_fifo(st)) return write_in_place(file, write);
+    if (!fs::is_regular_file(st))
+      return Error{Status::io_error, file_in.string() + ": not a regular file, not replaced"};
+  }
+  const fs::path dir = file.has_parent_path() ? file.parent_path() : fs::path(".");
   if (!fs::is_directory(dir, ec))
-    return Error{Status::io_error, file.string() + ": folder does not exist"};
+    return Error{Status::io_error, file_in.string() + ": folder does not exist"};
+  remove_stale_temporaries(dir);
   // Hidden, unique temporary in the same folder so the rename is atomic (same filesystem).
   std::random_device rd;
-  const fs::path tmp = dir / ("." + file.filename().string() + ".tmp" + std::to_string(::getpid()) +
-                              "_" + std::to_string(rd() & 0xffffff));
+  char name[64];
+  std::snprintf(name, sizeof name, "%s%ld-%06x%s", kPrefix, static_cast<long>(::getpid()),
+                static_cast<unsigned>(rd() & 0xffffff), kSuffix);
+  const fs::path tmp = dir / name;
   bool ok = false;
+  int err = 0;
   const PendingGuard pending(tmp.string());
   {
     std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
     if (!out)
-      return Error{Status::io_error, file.string() + ": cannot write: " + std::strerror(errno)};
+      return Error{Status::io_error, file_in.string() + ": cannot write in " + dir.string() + ": " +
+                                         std::strerror(errno)};
+    errno = 0;
     ok = write(out);
     out.flush();
     ok = ok && out.good();
+    err = errno;
   }
   if (!ok) {
     fs::remove(tmp, ec);
-    return Error{Status::io_error, file.string() + ": write failed"};
+    // A full disk says so (ENOSPC), naming the folder whose disk it is.
+    return Error{
+        Status::io_error,
+        file_in.string() + ": write failed" +
+            (err ? std::string(": ") + std::strerror(err) + " (in " + dir.string() + ")" : "")};
   }
   fs::rename(tmp, file, ec);
   if (ec) {
+    const std::string why = ec.message();
     fs::remove(tmp, ec);
-    return Error{Status::io_error,
-                 file.string() + ": cannot rename temporary file: " + ec.message()};
+    return Error{Status::io_error, file_in.string() + ": cannot rename temporary file: " + why};
   }
   return true;
 }
