@@ -10,6 +10,7 @@
 #include "nonplanar/config.hpp"
 #include "nonplanar/deform.hpp"
 #include "nonplanar/surface_io.hpp"
+#include "nonplanar/toolhead.hpp"
 
 #if NONPLANAR_FUZZ_PARSER == 8
 #include <cmath>
@@ -66,8 +67,19 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   o.start = Vec3(100, 100, 3);
   o.start_retracted = 0.8;
   (void)map_foreign_gcode(in, field, {}, {}, o);
+#elif NONPLANAR_FUZZ_PARSER == 9
+  // A head file that parses must also answer the collision search's queries.
+  const auto shape = parse_toolhead_shape(in);
+  if (!shape) return 0;
+  Toolhead t;
+  t.shape = *shape;
+  const HeadClearance head(t), low(t, 2.0);
+  for (const Vec2& d : {Vec2(0, 0), Vec2(3, -4), Vec2(-25, 10)})
+    (void)head.allowance(d), (void)low.allowance(d), (void)head.block_allowance(d);
+  (void)head.allowance_lower_bound(Vec2(-10, -10), Vec2(10, 10));
+  (void)t.describe();
 #else
-#error "NONPLANAR_FUZZ_PARSER must name a parser (0-8)"
+#error "NONPLANAR_FUZZ_PARSER must name a parser (0-9)"
 #endif
   return 0;
 }

@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
 # Run the libFuzzer targets (one per parser; AddressSanitizer + UndefinedBehaviorSanitizer).
 # Usage: fuzz/run.sh [SECONDS=60] [TARGET...]
-#   TARGET: stl obj off 3mf ini json surfaces gcode foreign (default: all of them, two at a
-#   time; foreign is the mapping of another slicer's G-code, map_foreign_gcode).
+#   TARGET: stl obj off 3mf ini json surfaces gcode foreign toolhead (default: all of them,
+#   two at a time; foreign is the mapping of another slicer's G-code, map_foreign_gcode;
+#   toolhead is a head shape file, docs/toolhead.md).
 # Builds the missing targets in build-san/ with scripts/sanitize.sh --build-only.
-# Seeds come from ../shared/models and tests/data; corpora grow in build-san/corpus/TARGET,
+# Seeds come from ../shared/models, tests/data and toolheads/; corpora grow in build-san/corpus/TARGET,
 # so longer runs pick up where the last one stopped. Findings are written to
 # build-san/findings/ and the script fails when any target crashes, leaks or reports UB.
 # To fuzz longer, e.g. an hour per target: fuzz/run.sh 3600
@@ -13,7 +14,7 @@ cd "$(dirname "$0")/.."
 secs=${1:-60}
 shift || true
 targets=("$@")
-((${#targets[@]})) || targets=(stl obj off 3mf ini json surfaces gcode foreign)
+((${#targets[@]})) || targets=(stl obj off 3mf ini json surfaces gcode foreign toolhead)
 out=${BUILD_DIR:-build-san}
 missing=0
 for t in "${targets[@]}"; do [[ -x "$out/fuzz/fuzz_$t" ]] || missing=1; done
@@ -34,6 +35,7 @@ seed stl "$models"/*.stl
 seed obj "$models"/*.obj
 seed off "$models"/*.off
 seed ini tests/data/*.ini
+seed toolhead toolheads/*.json
 mkdir -p "$out/corpus/json" "$out/corpus/surfaces" "$out/corpus/gcode" "$out/corpus/3mf" \
   "$out/corpus/foreign"
 printf '{"layer_height": 0.2, "fill_density": "20%%", "bed_shape": "0x0,220x0,220x220,0x220"}' \

@@ -1,0 +1,21 @@
+#!/usr/bin/env bash
+# The test suite under ThreadSanitizer, built with clang-14 into build-tsan/: the pipeline's
+# stages run tbb::parallel_for (layers, slicing, toolpaths, deform, analysis), and a data race
+# there would print differently from run to run. Any report fails the test that triggered it.
+# TBB itself is Debian's uninstrumented build; scripts/tsan.supp lists what is suppressed there.
+# Usage: scripts/tsan.sh [CTEST_REGEX]   (default: every test)
+# Environment: BUILD_DIR (default build-tsan); CI=true turns warnings into errors.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bash scripts/setup.sh --with-clang
+build_dir=${BUILD_DIR:-build-tsan}
+werror=OFF
+[[ "${CI:-}" == "true" ]] && werror=ON
+generator=()
+command -v ninja >/dev/null && [[ ! -f "$build_dir/CMakeCache.txt" ]] && generator=(-G Ninja)
+CXX=clang++-14 cmake -S . -B "$build_dir" "${generator[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  -DNONPLANAR_TSAN=ON -DNONPLANAR_BUILD_BENCH=OFF -DNONPLANAR_WERROR="$werror" >/dev/null
+cmake --build "$build_dir" -j"$(nproc)"
+export TSAN_OPTIONS=${TSAN_OPTIONS:-halt_on_error=1:second_deadlock_stack=1:suppressions=$PWD/scripts/tsan.supp}
+cd "$build_dir"
+ctest --output-on-failure -j"$(nproc)" --timeout 1800 ${1:+-R "$1"}
