@@ -17,21 +17,13 @@ struct CheckOptions {
   ProfileOptions profile;
   std::string gcode;
   double max_angle = 30;
-  // The head, as options too (kept from before the profile carried it).
-  std::string tip_radius, block_radius, block_clearance;
   bool json = false;
 };
 
 int run(const CheckOptions& o) {
-  std::vector<std::string> head;
-  for (const auto& [key, v] : {std::pair{"nozzle_tip_radius", &o.tip_radius},
-                               {"heater_block_radius", &o.block_radius},
-                               {"heater_block_clearance", &o.block_clearance}})
-    if (!v->empty()) head.push_back(std::string(key) + "=" + *v);
-  auto cfg = o.profile.load(head);
+  auto cfg = o.profile.load();
   if (!cfg) return report_error(cfg.error());
-  if (!(o.max_angle > 0 && o.max_angle < 90))
-    return report_error({Status::invalid_argument, "max_angle: must be in (0, 90) degrees"});
+  if (auto a = check_max_angle(o.max_angle); !a) return report_error(a.error());
   const CheckParams params = check_params(*cfg, o.max_angle);
   Context ctx = make_context(o.mesh.quiet || o.json);
   auto bytes = io::read_file_bytes(o.gcode, 2ull << 30);
@@ -117,9 +109,13 @@ void register_check(CLI::App& app, std::function<int()>* run_fn) {
   cmd->add_option("--scale", o->mesh.load.scale, "Scale applied when slicing");
   cmd->add_option("--max-angle", o->max_angle, "Printable facet slope (deg)")
       ->capture_default_str();
-  cmd->add_option("--nozzle-tip-radius", o->tip_radius, "mm (= --set nozzle_tip_radius=…)");
-  cmd->add_option("--block-radius", o->block_radius, "mm (= --set heater_block_radius=…)");
-  cmd->add_option("--block-clearance", o->block_clearance, "mm (= --set heater_block_clearance=…)");
+  // The head, as options too (kept from before the profile carried it).
+  o->profile.add_keyed(*cmd, "--nozzle-tip-radius", "nozzle_tip_radius",
+                       "mm (= --set nozzle_tip_radius=…)");
+  o->profile.add_keyed(*cmd, "--block-radius", "heater_block_radius",
+                       "mm (= --set heater_block_radius=…)");
+  o->profile.add_keyed(*cmd, "--block-clearance", "heater_block_clearance",
+                       "mm (= --set heater_block_clearance=…)");
   cmd->add_flag("--json", o->json, "Print one JSON document");
   cmd->add_flag("-q,--quiet", o->mesh.quiet, "No progress on stderr");
   *run_fn = nullptr;

@@ -66,16 +66,24 @@ Expected<std::pair<std::string, std::string>> apply_setting(PrintConfig& c, cons
   return p;
 }
 
-Expected<PrintConfig> ProfileOptions::load(const std::vector<std::string>& extra) const {
+void ProfileOptions::add_keyed(CLI::App& cmd, const std::string& name, const std::string& key,
+                               const std::string& help) {
+  keyed.emplace_back(key, "");
+  cmd.add_option(name, keyed.back().second, help);
+}
+
+Expected<PrintConfig> ProfileOptions::load() const {
   PrintConfig cfg;
   if (!config.empty()) {
     auto c = load_config(config);
     if (!c) return c.error();
     cfg = std::move(*c);
   }
-  for (const auto* list : {&extra, &sets})
-    for (const std::string& kv : *list)
-      if (auto r = apply_setting(cfg, kv); !r) return r.error();
+  for (const auto& [key, value] : keyed)
+    if (!value.empty())
+      if (auto r = apply_setting(cfg, key + "=" + value); !r) return r.error();
+  for (const std::string& kv : sets)
+    if (auto r = apply_setting(cfg, kv); !r) return r.error();
   if (auto v = validate_config(cfg); !v) return v.error();
   return cfg;
 }
@@ -97,6 +105,11 @@ void add_analysis_options(CLI::App& cmd, AnalysisParams& p) {
       ->capture_default_str();
   cmd.add_option("--min-patch-area", p.min_patch_area, "Smaller patches are dropped (mm^2)")
       ->capture_default_str();
+}
+
+Expected<bool> check_max_angle(double max_angle_deg) {
+  if (max_angle_deg > 0 && max_angle_deg < 90) return true;
+  return Error{Status::invalid_argument, "max_angle: must be in (0, 90) degrees"};
 }
 
 namespace {

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
+#include <list>
 #include <string>
 #include <utility>
 #include <vector>
@@ -38,12 +39,21 @@ struct MeshOptions {
 struct ProfileOptions {
   std::string config;
   std::vector<std::string> sets;
+  /// A subcommand's own options that are profile keys (--block-radius is
+  /// heater_block_radius): key and the value given, applied before `sets`. A list, so the
+  /// strings CLI11 writes into stay put.
+  std::list<std::pair<std::string, std::string>> keyed;
   /// `what` names the subcommand's use of the profile in --config's help.
   void add_to(CLI::App& cmd, const std::string& what);
+  /// Adds option `name` that sets profile key `key`.
+  void add_keyed(CLI::App& cmd, const std::string& name, const std::string& key,
+                 const std::string& help);
   /// The profile with the overrides applied and validated; errors name the file or the key.
-  /// `extra` are KEY=VALUE pairs applied before `sets` (a subcommand's own options).
-  Expected<PrintConfig> load(const std::vector<std::string>& extra = {}) const;
+  Expected<PrintConfig> load() const;
 };
+
+/// max_angle in (0, 90) degrees (NaN refused), or the error every subcommand gives.
+Expected<bool> check_max_angle(double max_angle_deg);
 
 /// Applies "KEY=VALUE" to c; the error names the key ("--set: …" for a malformed pair).
 Expected<std::pair<std::string, std::string>> apply_setting(PrintConfig& c, const std::string& kv);

@@ -21,27 +21,18 @@ struct LayersOptions {
   AnalysisParams analysis;
   FitParams fit;
   LayerParams tuning;  ///< the optimiser's settings (the limits come from the profile)
-  // Profile keys as options: layer_height, first_layer_height, max_layer_height,
-  // heater_block_radius, heater_block_clearance.
-  std::string keyed[5];
   bool json = false;
   std::string export_layers, export_normalized, section, at;
 };
 
 // The job `slice` would run with the same profile (make_job), the optimiser tuned as asked.
 Expected<SliceJob> layers_job(const LayersOptions& o) {
-  static const char* keys[] = {"layer_height", "first_layer_height", "max_layer_height",
-                               "heater_block_radius", "heater_block_clearance"};
-  std::vector<std::string> extra;
-  for (std::size_t i = 0; i < std::size(keys); ++i)
-    if (!o.keyed[i].empty()) extra.push_back(std::string(keys[i]) + "=" + o.keyed[i]);
-  auto cfg = o.profile.load(extra);
+  auto cfg = o.profile.load();
   if (!cfg) return cfg.error();
   // --min-layer-height is the profile's min_layer_height unless the profile sets one.
   if (cfg->min_layer_height == 0)
     cfg->min_layer_height = std::min(o.analysis.min_layer_height, cfg->slice.layer_height);
-  if (!(o.analysis.max_angle_deg > 0 && o.analysis.max_angle_deg < 90))
-    return Error{Status::invalid_argument, "max_angle: must be in (0, 90) degrees"};
+  if (auto a = check_max_angle(o.analysis.max_angle_deg); !a) return a.error();
   SliceJob job = make_job(*cfg, o.analysis.max_angle_deg);
   AnalysisParams a = o.analysis;
   a.max_angle_deg = job.analysis.max_angle_deg;
@@ -199,14 +190,16 @@ void register_layers(CLI::App& app, std::function<int()>* run_fn) {
   add_analysis_options(*cmd, opts->analysis);
   opts->profile.add_to(*cmd, "layer heights, limits, the toolhead; as `slice` reads it");
   LayerParams& l = opts->tuning;
-  cmd->add_option("--layer-height", opts->keyed[0], "Layer height h (mm; default 0.2)");
-  cmd->add_option("--first-layer-height", opts->keyed[1], "First layer (mm)");
-  cmd->add_option("--max-layer-height", opts->keyed[2],
-                  "Thickest curved layer (mm; default automatic, as `slice`)");
-  cmd->add_option("--block-radius", opts->keyed[3],
-                  "Heater block radius around the nozzle (mm; = heater_block_radius)");
-  cmd->add_option("--block-clearance", opts->keyed[4],
-                  "Heater block bottom above the nozzle tip (mm; = heater_block_clearance)");
+  opts->profile.add_keyed(*cmd, "--layer-height", "layer_height",
+                          "Layer height h (mm; default 0.2)");
+  opts->profile.add_keyed(*cmd, "--first-layer-height", "first_layer_height", "First layer (mm)");
+  opts->profile.add_keyed(*cmd, "--max-layer-height", "max_layer_height",
+                          "Thickest curved layer (mm; default automatic, as `slice`)");
+  opts->profile.add_keyed(*cmd, "--block-radius", "heater_block_radius",
+                          "Heater block radius around the nozzle (mm; = heater_block_radius)");
+  opts->profile.add_keyed(
+      *cmd, "--block-clearance", "heater_block_clearance",
+      "Heater block bottom above the nozzle tip (mm; = heater_block_clearance)");
   cmd->add_option("--continuity-weight", l.continuity_weight, "lambda of the paper's eq. (1)")
       ->capture_default_str();
   const std::map<std::string, StackOptimizer> opt = {{"lbfgs", StackOptimizer::lbfgs},

@@ -59,8 +59,7 @@ int run(const SliceOptions& o) {
     if (!is_nonplanar_key(applied->first)) engine.overrides.push_back(std::move(*applied));
   }
   if (auto v = validate_config(cfg); !v) return report_error(v.error());
-  if (!(o.max_angle > 0 && o.max_angle < 90))  // also catches NaN
-    return report_error({Status::invalid_argument, "max_angle: must be in (0, 90) degrees"});
+  if (auto a = check_max_angle(o.max_angle); !a) return report_error(a.error());
   if (!o.mesh.quiet)
     for (const auto& n : cfg.notes) std::fprintf(stderr, "warning: %s\n", n.c_str());
 

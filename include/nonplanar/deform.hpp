@@ -27,7 +27,7 @@ struct MapBackParams {
   double tolerance = 0.01;  ///< max distance of a straight segment from its curved layer, mm
   // Travels over curved layers (travel_height, toolhead.hpp); mm.
   double tip_radius = 0.4;   ///< the nozzle tip's flat (Toolhead::tip_radius)
-  double travel_lift = 0.3;  ///< over the layer's highest point: max(0.3, retract_lift)
+  double travel_lift = 0.3;  ///< over the layer's highest point: travel_lift(retract_lift)
 };
 
 /// Maps toolpaths sliced from the normalised mesh back onto the curved layers:

@@ -81,4 +81,8 @@ class HeadClearance {
 double travel_height(const Vec3& from, const Vec3& to, double layer_top, double slope,
                      double tip_radius, double lift);
 
+/// The `lift` of a long travel over a curved layer for a printer whose z-hop is
+/// `retract_lift` (mm): that, but at least 0.3 mm.
+double travel_lift(double retract_lift);
+
 }  // namespace nonplanar

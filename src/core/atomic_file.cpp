@@ -41,8 +41,9 @@ void remove_stale_temporaries(const std::filesystem::path& dir) {
   std::error_code ec;
   for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
     const std::string name = it->path().filename().string();
-    if (name.rfind(kPrefix, 0) != 0 || name.size() < sizeof kSuffix ||
-        name.compare(name.size() - 4, 4, kSuffix) != 0)
+    constexpr std::size_t n_suffix = sizeof kSuffix - 1;
+    if (name.rfind(kPrefix, 0) != 0 || name.size() < n_suffix ||
+        name.compare(name.size() - n_suffix, n_suffix, kSuffix) != 0)
       continue;
     const std::string rest = name.substr(sizeof kPrefix - 1);
     char* end_pid = nullptr;

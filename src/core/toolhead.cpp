@@ -40,6 +40,15 @@ double tan_deg(double deg) {
   return std::tan(deg * M_PI / 180.0);
 }
 
+// Farthest offset of a shaped head: the cone up to `cone_height`, and every slice's corners.
+double shape_reach(const Toolhead& h, double cone_height) {
+  double r = h.tip_radius + cone_height / tan_deg(h.cone_angle_deg);
+  for (const ToolheadSlice& s : h.shape)
+    for (const auto& poly : s.polygons)
+      for (const Vec2& v : poly) r = std::max(r, v.norm());
+  return r;
+}
+
 }  // namespace
 
 double Toolhead::cone_top() const {
@@ -56,13 +65,7 @@ double Toolhead::cone_top() const {
 }
 
 double Toolhead::reach() const {
-  if (shape.empty()) return block_radius;
-  // The cone up to where it meets the head, and every slice's corners.
-  double r = tip_radius + cone_top() / tan_deg(cone_angle_deg);
-  for (const ToolheadSlice& s : shape)
-    for (const auto& poly : s.polygons)
-      for (const Vec2& v : poly) r = std::max(r, v.norm());
-  return r;
+  return shape.empty() ? block_radius : shape_reach(*this, cone_top());
 }
 
 double Toolhead::clearance() const {
@@ -97,10 +100,7 @@ HeadClearance::HeadClearance(const Toolhead& head, double tallest)
   if (!shaped_) return;
   // A slice at or above `tallest` never holds a(d) below what material can reach.
   std::erase_if(head_.shape, [&](const ToolheadSlice& s) { return s.height >= tallest; });
-  reach_ = head_.tip_radius + std::min(cone_top_, std::max(0.0, tallest)) / tan_cone_;
-  for (const ToolheadSlice& s : head_.shape)
-    for (const auto& poly : s.polygons)
-      for (const Vec2& v : poly) reach_ = std::max(reach_, v.norm());
+  reach_ = shape_reach(head_, std::min(cone_top_, std::max(0.0, tallest)));
 }
 
 // `nearest`: the offset nearest the axis (of the box, or d itself); with in_box, slices count
@@ -141,6 +141,10 @@ double travel_height(const Vec3& from, const Vec3& to, double layer_top, double 
   if (far) return std::max({layer_top, from.z(), to.z()}) + lift;
   if (hop > 0.05) return std::max(from.z(), to.z()) + hop + 0.05;
   return std::numeric_limits<double>::quiet_NaN();
+}
+
+double travel_lift(double retract_lift) {
+  return std::max(0.3, retract_lift);
 }
 
 }  // namespace nonplanar

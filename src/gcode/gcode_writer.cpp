@@ -103,7 +103,7 @@ class Emitter {
       const double d = (p.head<2>() - pos_.head<2>()).norm();
       if (d < 1e-6 && std::abs(p.z() - pos_.z()) < 1e-6) return;
       const double lift =
-          travel_height(pos_, p, safe_z, slope, tip_radius_, std::max(0.3, g_.retract_lift));
+          travel_height(pos_, p, safe_z, slope, tip_radius_, travel_lift(g_.retract_lift));
       if (!std::isnan(lift)) {
         if (d > g_.retract_before_travel) retract();
         line("G1 Z%.3f F%d", lift, static_cast<int>(speed * 60));
