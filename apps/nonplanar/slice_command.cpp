@@ -152,7 +152,7 @@ void register_slice(CLI::App& app, std::function<int()>* run_fn) {
       {"bed_temperature", "Bed temperature (C)"},
       {"nozzle_diameter", "Nozzle diameter (mm)"},
       {"filament_diameter", "Filament diameter (mm)"},
-      {"extrusion_width", "Extrusion width (mm or % of nozzle)"},
+      {"extrusion_width", "Extrusion width (mm, % of layer height, 0 = 1.125 x nozzle)"},
       {"retract_length", "Retraction length (mm)"},
       {"retract_lift", "Z-hop on retraction (mm)"},
       {"skirts", "Skirt loops"},

@@ -24,9 +24,10 @@ enum class InfillPattern { rectilinear, grid };
 /// Inputs of make_toolpaths.
 struct ToolpathParams {
   double nozzle_diameter = 0.4;
-  double extrusion_width = 0.45;  ///< perimeters and infill
+  double extrusion_width = 0.45;  ///< infill (and the default of the other widths)
+  double perimeter_width = 0.45;  ///< inner perimeters
   double external_perimeter_width = 0.45;
-  double first_layer_width = 0.5;
+  double first_layer_width = 0.5;  ///< every extrusion of the first layer
   int perimeters = 2;
   int top_solid_layers = 5;
   int bottom_solid_layers = 4;
@@ -63,20 +64,42 @@ struct GcodeParams {
       "M104 S0 ; heater off\nM140 S0 ; bed off\nM107\nG91\nG1 Z10 F600\nG90\nM84\n";
 };
 
+/// Settings PrusaSlicer states relative to others, as written: "150%" (widths: of the layer
+/// height, the first layer's for the first layer's width; first_layer_height: of the layer
+/// height; speeds: of another speed) or 0 for a width (automatic: 1.125 × nozzle for
+/// extrusion_width, and extrusion_width for the other widths). Every set_config_value() resolves
+/// them all again, so the result does not depend on the order of the keys (`prusa-slicer --save`
+/// writes them alphabetically, nozzle_diameter after the widths).
+struct RelativeSettings {
+  std::string first_layer_height = "0.2";
+  std::string extrusion_width = "0", perimeter_width = "0", infill_width = "0",
+              external_perimeter_width = "0", first_layer_width = "250%";
+  std::string external_perimeter_speed = "25", solid_infill_speed = "60",
+              top_solid_infill_speed = "40", first_layer_speed = "20";
+  bool start_gcode_given = false;  ///< else the default start G-code is made for the bed
+};
+
 /// Everything a print needs.
 struct PrintConfig {
   Vec2 bed_min{0, 0}, bed_max{220, 220};  ///< bed_shape's bounding box
   /// Thinnest and thickest layer the printer prints well, h_min and h_max of the curved layers
   /// (PrusaSlicer's min_layer_height / max_layer_height, mm). 0 = automatic:
-  /// h_min = min(0.1, layer_height), h_max = max(1.5 layer_height, min(0.75 nozzle, 0.3)).
+  /// h_min = min(0.1, layer_height),
+  /// h_max = min(nozzle, max(1.5 layer_height, min(0.75 nozzle, 0.3))).
   double min_layer_height = 0, max_layer_height = 0;
   SliceParams slice;
   ToolpathParams paths;
   GcodeParams gcode;
-  Toolhead toolhead;  ///< nozzle cone, heater block, the rest of the head (toolhead.hpp)
+  Toolhead toolhead;          ///< nozzle cone, heater block, the rest of the head (toolhead.hpp)
+  RelativeSettings relative;  ///< what the relative fields above were resolved from
   std::vector<std::string> notes;  ///< settings that were read but adapted (shown as warnings)
   Vec2 bed_center() const { return 0.5 * (bed_min + bed_max); }
 };
+
+/// The start G-code used when a profile gives none: home, heat (the writer waits), and a
+/// purge line along the bed's left edge, 2 mm in, from 10 % to 90 % of its depth (at most
+/// 20 mm from either end). For the default 220 × 220 bed: X2, Y20 → Y200, 15 mm of filament.
+std::string default_start_gcode(const Vec2& bed_min, const Vec2& bed_max);
 
 /// Sets one setting by its PrusaSlicer key (e.g. "layer_height", "fill_density" = "20%",
 /// "bed_shape" = "0x0,220x0,220x220,0x220", "gcode_flavor" = "marlin2"). Unknown keys are

@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <optional>
 #include <sstream>
+#include <tuple>
 
 #include "io/mesh_buffer.hpp"
 #include "nonplanar/config.hpp"
@@ -54,9 +55,37 @@ std::string unescape(const std::string& v) {
   return out;
 }
 
+// PrusaSlicer's rules, checked against prusa-slicer 2.5's own G-code header: a width in % is
+// of the layer height (the first layer's, for first_layer_extrusion_width), not of the
+// nozzle; a role's width of 0 means extrusion_width, and extrusion_width 0 means
+// 1.125 × nozzle. (A 0.8 mm nozzle at 0.3 mm layers: 200 % is 0.60 mm, 0 is 0.90 mm.)
+void resolve_relative(PrintConfig& c) {
+  const RelativeSettings& r = c.relative;
+  ToolpathParams& t = c.paths;
+  auto of = [](const std::string& text, double base) {
+    return number_or_percent(text, base).value_or(0.0);  // checked when it was set
+  };
+  const double lh = c.slice.layer_height;
+  c.slice.first_layer_height = of(r.first_layer_height, lh);
+  const double w0 = of(r.extrusion_width, lh);
+  const double w = w0 > 0 ? w0 : 1.125 * t.nozzle_diameter;
+  auto role = [&](const std::string& text, double base) {
+    return of(text, base) > 0 ? of(text, base) : w;
+  };
+  t.extrusion_width = role(r.infill_width, lh);
+  t.perimeter_width = role(r.perimeter_width, lh);
+  t.external_perimeter_width = role(r.external_perimeter_width, lh);
+  t.first_layer_width = role(r.first_layer_width, c.slice.first_layer_height);
+  t.external_perimeter_speed = of(r.external_perimeter_speed, t.perimeter_speed);
+  t.solid_infill_speed = of(r.solid_infill_speed, t.infill_speed);
+  t.top_solid_infill_speed = of(r.top_solid_infill_speed, t.solid_infill_speed);
+  t.first_layer_speed = of(r.first_layer_speed, t.perimeter_speed);
+  if (!r.start_gcode_given) c.gcode.start_gcode = default_start_gcode(c.bed_min, c.bed_max);
+}
+
 }  // namespace
 
-Expected<bool> set_config_value(PrintConfig& c, const std::string& key, const std::string& value) {
+Expected<bool> set_value(PrintConfig& c, const std::string& key, const std::string& value) {
   ToolpathParams& t = c.paths;
   GcodeParams& g = c.gcode;
   auto num = [&](double& field) -> Expected<bool> {
@@ -72,21 +101,16 @@ Expected<bool> set_config_value(PrintConfig& c, const std::string& key, const st
     field = static_cast<int>(*d);
     return true;
   };
-  auto pct = [&](double& field, double base) -> Expected<bool> {
-    const auto d = number_or_percent(value, base);
-    if (!d) return bad(key, "'" + value + "' is not a number or a percentage");
-    field = *d;
+  // A relative setting: checked now, resolved with the others after every key.
+  auto rel = [&](std::string& text) -> Expected<bool> {
+    const auto d = number_or_percent(value, 1.0);
+    if (!d || *d < 0) return bad(key, "'" + value + "' is not a number >= 0 or a percentage");
+    text = first_item(value);
     return true;
   };
-  // Widths: 0 means "auto" (1.125 × nozzle, as PrusaSlicer); percentages are of the nozzle.
-  auto width = [&](double& field) -> Expected<bool> {
-    const auto d = number_or_percent(value, t.nozzle_diameter);
-    if (!d) return bad(key, "'" + value + "' is not a width");
-    field = *d == 0 ? 1.125 * t.nozzle_diameter : *d;
-    return true;
-  };
+  RelativeSettings& r = c.relative;
   if (key == "layer_height") return num(c.slice.layer_height);
-  if (key == "first_layer_height") return pct(c.slice.first_layer_height, c.slice.layer_height);
+  if (key == "first_layer_height") return rel(r.first_layer_height);
   if (key == "min_layer_height") return num(c.min_layer_height);
   if (key == "max_layer_height") return num(c.max_layer_height);
   if (key == "nozzle_diameter") return num(t.nozzle_diameter);
@@ -96,10 +120,11 @@ Expected<bool> set_config_value(PrintConfig& c, const std::string& key, const st
   if (key == "top_solid_layers") return integer(t.top_solid_layers);
   if (key == "bottom_solid_layers") return integer(t.bottom_solid_layers);
   if (key == "fill_density") {
-    auto r = pct(t.fill_density, 1.0);
+    const auto d = number_or_percent(value, 1.0);
+    if (!d) return bad(key, "'" + value + "' is not a number or a percentage");
     // "0.2" and "20%" both mean 20 %; a bare number above 1 is a percentage too.
-    if (r && t.fill_density > 1.0 && value.find('%') == std::string::npos) t.fill_density /= 100.0;
-    return r;
+    t.fill_density = *d > 1.0 && value.find('%') == std::string::npos ? *d / 100.0 : *d;
+    return true;
   }
   if (key == "fill_pattern") {
     const std::string v = first_item(value);
@@ -116,17 +141,17 @@ Expected<bool> set_config_value(PrintConfig& c, const std::string& key, const st
   if (key == "fill_angle") return num(t.fill_angle);
   if (key == "skirts") return integer(t.skirts);
   if (key == "skirt_distance") return num(t.skirt_distance);
-  if (key == "extrusion_width" || key == "perimeter_extrusion_width" ||
-      key == "infill_extrusion_width")
-    return width(t.extrusion_width);
-  if (key == "external_perimeter_extrusion_width") return width(t.external_perimeter_width);
-  if (key == "first_layer_extrusion_width") return width(t.first_layer_width);
+  if (key == "extrusion_width") return rel(r.extrusion_width);
+  if (key == "perimeter_extrusion_width") return rel(r.perimeter_width);
+  if (key == "infill_extrusion_width") return rel(r.infill_width);
+  if (key == "external_perimeter_extrusion_width") return rel(r.external_perimeter_width);
+  if (key == "first_layer_extrusion_width") return rel(r.first_layer_width);
   if (key == "perimeter_speed") return num(t.perimeter_speed);
-  if (key == "external_perimeter_speed") return pct(t.external_perimeter_speed, t.perimeter_speed);
+  if (key == "external_perimeter_speed") return rel(r.external_perimeter_speed);
   if (key == "infill_speed") return num(t.infill_speed);
-  if (key == "solid_infill_speed") return pct(t.solid_infill_speed, t.infill_speed);
-  if (key == "top_solid_infill_speed") return pct(t.top_solid_infill_speed, t.solid_infill_speed);
-  if (key == "first_layer_speed") return pct(t.first_layer_speed, t.perimeter_speed);
+  if (key == "solid_infill_speed") return rel(r.solid_infill_speed);
+  if (key == "top_solid_infill_speed") return rel(r.top_solid_infill_speed);
+  if (key == "first_layer_speed") return rel(r.first_layer_speed);
   if (key == "travel_speed") return num(t.travel_speed);
   if (key == "temperature") return num(g.temperature);
   if (key == "first_layer_temperature") return num(g.first_layer_temperature);
@@ -157,7 +182,10 @@ Expected<bool> set_config_value(PrintConfig& c, const std::string& key, const st
       return bad(key, "'" + v + "' is not marlin2, klipper or reprapfirmware");
     return true;
   }
-  if (key == "start_gcode") return g.start_gcode = unescape(value), true;
+  if (key == "start_gcode") {
+    r.start_gcode_given = true;
+    return g.start_gcode = unescape(value), true;
+  }
   if (key == "end_gcode") return g.end_gcode = unescape(value), true;
   Toolhead& head = c.toolhead;
   if (key == "nozzle_tip_radius") return num(head.tip_radius);
@@ -199,21 +227,41 @@ Expected<bool> set_config_value(PrintConfig& c, const std::string& key, const st
   return false;
 }
 
+Expected<bool> set_config_value(PrintConfig& c, const std::string& key, const std::string& value) {
+  auto r = set_value(c, key, value);
+  if (r && *r) resolve_relative(c);
+  return r;
+}
+
+std::string default_start_gcode(const Vec2& bed_min, const Vec2& bed_max) {
+  const double depth = bed_max.y() - bed_min.y();
+  const double margin = std::min(20.0, 0.1 * depth);
+  const double y0 = bed_min.y() + margin, y1 = bed_max.y() - margin;
+  char purge[160];
+  std::snprintf(purge, sizeof purge, "G1 X%g Y%g Z0.3 F6000\nG1 Y%g E%g F1200 ; purge line\n",
+                bed_min.x() + 2.0, y0, y1, std::round(15.0 * (y1 - y0) / 180.0 * 100.0) / 100.0);
+  return "G28 ; home all axes\nG1 Z5 F5000 ; lift nozzle\nG92 E0\n" + std::string(purge) +
+         "G92 E0\n";
+}
+
 bool is_nonplanar_key(const std::string& key) {
   return key == "nozzle_tip_radius" || key == "nozzle_cone_angle" || key == "heater_block_radius" ||
          key == "heater_block_clearance" || key == "toolhead_shape";
 }
 
+// Ranges: wide enough for any real printer, narrow enough that every value formats into a
+// sane G-code line (travel_speed=1e10 once wrote F-2147483648, max_fan_speed=1000 M106 S2550).
 Expected<bool> validate_config(const PrintConfig& c) {
-  auto pos = [](double v) { return std::isfinite(v) && v > 0; };
+  auto in = [](double v, double lo, double hi) { return std::isfinite(v) && v >= lo && v <= hi; };
+  auto pos = [](double v, double hi) { return std::isfinite(v) && v > 0 && v <= hi; };
   const ToolpathParams& t = c.paths;
   const GcodeParams& g = c.gcode;
-  if (!pos(c.slice.layer_height)) return bad("layer_height", "must be a finite number > 0");
-  if (!pos(c.slice.first_layer_height))
-    return bad("first_layer_height", "must be a finite number > 0");
-  if (!pos(t.nozzle_diameter)) return bad("nozzle_diameter", "must be a finite number > 0");
-  if (c.slice.layer_height > t.nozzle_diameter)
-    return bad("layer_height", "is larger than the nozzle diameter");
+  const double d = t.nozzle_diameter;
+  if (!pos(d, 3)) return bad("nozzle_diameter", "must be in (0, 3] mm");
+  if (!pos(c.slice.layer_height, d))
+    return bad("layer_height", "must be > 0 and at most the nozzle diameter");
+  if (!pos(c.slice.first_layer_height, d))
+    return bad("first_layer_height", "must be > 0 and at most the nozzle diameter");
   for (const auto& [k, v] : {std::pair{"min_layer_height", c.min_layer_height},
                              {"max_layer_height", c.max_layer_height}})
     if (!std::isfinite(v) || v < 0) return bad(k, "must be a finite number >= 0 (0: automatic)");
@@ -223,19 +271,25 @@ Expected<bool> validate_config(const PrintConfig& c) {
     return bad("min_layer_height", "is above layer_height");
   if (c.max_layer_height > 0 && c.max_layer_height < c.slice.layer_height)
     return bad("max_layer_height", "is below layer_height");
-  if (c.max_layer_height > t.nozzle_diameter)
-    return bad("max_layer_height", "is larger than the nozzle diameter");
-  if (!pos(g.filament_diameter)) return bad("filament_diameter", "must be a finite number > 0");
-  if (!pos(g.extrusion_multiplier)) return bad("extrusion_multiplier", "must be > 0");
-  for (const auto& [k, v] : {std::pair{"extrusion_width", t.extrusion_width},
-                             {"external_perimeter_extrusion_width", t.external_perimeter_width},
-                             {"first_layer_extrusion_width", t.first_layer_width}})
-    if (!pos(v) || v < c.slice.layer_height) return bad(k, "must be at least the layer height");
+  if (c.max_layer_height > d) return bad("max_layer_height", "is larger than the nozzle diameter");
+  if (!pos(g.filament_diameter, 5)) return bad("filament_diameter", "must be in (0, 5] mm");
+  if (!pos(g.extrusion_multiplier, 5)) return bad("extrusion_multiplier", "must be in (0, 5]");
+  const double lh = c.slice.layer_height, fh = c.slice.first_layer_height;
+  for (const auto& [k, v, layer] :
+       {std::tuple{"extrusion_width", t.extrusion_width, lh},
+        {"perimeter_extrusion_width", t.perimeter_width, lh},
+        {"external_perimeter_extrusion_width", t.external_perimeter_width, lh},
+        {"first_layer_extrusion_width", t.first_layer_width, fh}}) {
+    if (!pos(v, 1e3) || v < layer) return bad(k, "must be at least its layer's height");
+    if (v >= 3 * d) return bad(k, "must be below 3 × the nozzle diameter (as PrusaSlicer)");
+  }
   if (t.perimeters < 0 || t.perimeters > 100) return bad("perimeters", "must be 0 to 100");
-  if (t.top_solid_layers < 0 || t.bottom_solid_layers < 0)
-    return bad("top_solid_layers/bottom_solid_layers", "must be >= 0");
-  if (!std::isfinite(t.fill_density) || t.fill_density < 0 || t.fill_density > 1)
-    return bad("fill_density", "must be in 0 % … 100 %");
+  if (t.top_solid_layers < 0 || t.top_solid_layers > 1000 || t.bottom_solid_layers < 0 ||
+      t.bottom_solid_layers > 1000)
+    return bad("top_solid_layers/bottom_solid_layers", "must be 0 to 1000");
+  if (!in(t.fill_density, 0, 1)) return bad("fill_density", "must be in 0 % … 100 %");
+  if (!in(t.fill_angle, -360, 360)) return bad("fill_angle", "must be -360 to 360 degrees");
+  if (t.skirts < 0 || t.skirts > 100) return bad("skirts", "must be 0 to 100");
   for (const auto& [k, v] : {std::pair{"perimeter_speed", t.perimeter_speed},
                              {"external_perimeter_speed", t.external_perimeter_speed},
                              {"infill_speed", t.infill_speed},
@@ -244,29 +298,33 @@ Expected<bool> validate_config(const PrintConfig& c) {
                              {"first_layer_speed", t.first_layer_speed},
                              {"travel_speed", t.travel_speed},
                              {"retract_speed", g.retract_speed}})
-    if (!pos(v)) return bad(k, "must be a finite speed > 0");
+    if (!pos(v, 1000)) return bad(k, "must be a speed in (0, 1000] mm/s");
+  if (!in(g.deretract_speed, 0, 1000))
+    return bad("deretract_speed", "must be 0 (retract_speed) to 1000 mm/s");
   for (const auto& [k, v] : {std::pair{"temperature", g.temperature},
                              {"first_layer_temperature", g.first_layer_temperature},
                              {"bed_temperature", g.bed_temperature},
                              {"first_layer_bed_temperature", g.first_layer_bed_temperature}})
-    if (!std::isfinite(v) || v < 0 || v > 500) return bad(k, "must be 0 to 500 °C");
-  for (const auto& [k, v] : {std::pair{"retract_length", g.retract_length},
-                             {"retract_before_travel", g.retract_before_travel},
-                             {"retract_lift", g.retract_lift},
-                             {"skirt_distance", t.skirt_distance}})
-    if (!std::isfinite(v) || v < 0) return bad(k, "must be a finite number >= 0");
+    if (!in(v, 0, 500)) return bad(k, "must be 0 to 500 °C");
+  for (const auto& [k, v, hi] : {std::tuple{"retract_length", g.retract_length, 50.0},
+                                 {"retract_before_travel", g.retract_before_travel, 1000.0},
+                                 {"retract_lift", g.retract_lift, 50.0},
+                                 {"skirt_distance", t.skirt_distance, 1000.0}})
+    if (!in(v, 0, hi)) return bad(k, "must be 0 to " + std::to_string(int(hi)) + " mm");
+  if (g.fan_speed < 0 || g.fan_speed > 100) return bad("max_fan_speed", "must be 0 to 100 %");
+  if (g.disable_fan_first_layers < 0) return bad("disable_fan_first_layers", "must be 0 or more");
   const Toolhead& h = c.toolhead;
-  if (!pos(h.tip_radius) || h.tip_radius > 5)
-    return bad("nozzle_tip_radius", "must be in (0, 5] mm");
+  if (!pos(h.tip_radius, 5)) return bad("nozzle_tip_radius", "must be in (0, 5] mm");
   if (!(h.cone_angle_deg >= 5 && h.cone_angle_deg <= 85))
     return bad("nozzle_cone_angle", "must be 5 to 85 degrees above horizontal");
-  if (!pos(h.block_radius) || h.block_radius > 200 || h.block_radius <= h.tip_radius)
+  if (!pos(h.block_radius, 200) || h.block_radius <= h.tip_radius)
     return bad("heater_block_radius", "must be above nozzle_tip_radius and at most 200 mm");
-  if (!pos(h.block_clearance) || h.block_clearance > 200)
-    return bad("heater_block_clearance", "must be in (0, 200] mm");
+  if (!pos(h.block_clearance, 200)) return bad("heater_block_clearance", "must be in (0, 200] mm");
   if (!c.bed_min.allFinite() || !c.bed_max.allFinite() || !(c.bed_max.x() > c.bed_min.x()) ||
       !(c.bed_max.y() > c.bed_min.y()))
     return bad("bed_shape", "is empty");
+  if (c.bed_min.cwiseAbs().maxCoeff() > 1e5 || c.bed_max.cwiseAbs().maxCoeff() > 1e5)
+    return bad("bed_shape", "corners must lie within 100 m of the origin");
   return true;
 }
 

@@ -26,10 +26,12 @@ SliceJob make_job(const PrintConfig& print, double max_angle_deg) {
   j.layers.min_layer_height = print.min_layer_height > 0
                                   ? print.min_layer_height
                                   : std::min(j.analysis.min_layer_height, print.slice.layer_height);
-  j.layers.max_layer_height = print.max_layer_height > 0
-                                  ? print.max_layer_height
-                                  : std::max(1.5 * print.slice.layer_height,
-                                             std::min(0.75 * print.paths.nozzle_diameter, 0.3));
+  j.layers.max_layer_height =
+      print.max_layer_height > 0
+          ? print.max_layer_height
+          : std::min(print.paths.nozzle_diameter,
+                     std::max(1.5 * print.slice.layer_height,
+                              std::min(0.75 * print.paths.nozzle_diameter, 0.3)));
   j.analysis.min_layer_height = j.layers.min_layer_height;
   // A layer steeper than the nozzle's outer wall drags the wall through the layer under it
   // (DESIGN.md §3): the cone bounds the slope, for the facets painted and the layers alike.

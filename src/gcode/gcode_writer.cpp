@@ -1,11 +1,15 @@
 // The G-code emitter: position, extrusion (absolute or relative), feed rate, retraction,
 // flavour; PrusaSlicer's preview annotations; no arcs. Text is built in memory and written
 // atomically, so a half-written file never exists under the final name.
+#include <algorithm>
+#include <cctype>
 #include <cinttypes>
 #include <cmath>
 #include <cstdarg>
 #include <cstdio>
+#include <optional>
 #include <string>
+#include <string_view>
 
 #include "core/atomic_file.hpp"
 #include "nonplanar/gcode.hpp"
@@ -60,10 +64,81 @@ std::string expand(std::string t, const PrintConfig& c) {
   return t;
 }
 
+// The command word of one line, upper-cased and without its comment: "M190", "G1", "".
+std::string command_of(std::string_view line) {
+  line = line.substr(0, line.find(';'));
+  const auto a = line.find_first_not_of(" \t");
+  if (a == std::string_view::npos) return {};
+  const auto b = line.find_first_of(" \t", a);
+  std::string w(line.substr(a, b == std::string_view::npos ? line.npos : b - a));
+  for (char& ch : w) ch = static_cast<char>(std::toupper(static_cast<unsigned char>(ch)));
+  return w;
+}
+
+// Does `block` hold `word` as a command? (A comment that mentions M190 is not one.)
+bool has_command(std::string_view block, std::string_view word) {
+  for (std::size_t p = 0; p < block.size();) {
+    const std::size_t e = std::min(block.find('\n', p), block.size());
+    if (command_of(block.substr(p, e - p)) == word) return true;
+    p = e + 1;
+  }
+  return false;
+}
+
+// The first placeholder or macro left in `block` outside comments, e.g. "{max_layer_z}" or
+// "[printer_model]"; "" when none.
+std::string leftover_placeholder(std::string_view block) {
+  for (std::size_t p = 0; p < block.size();) {
+    const std::size_t e = std::min(block.find('\n', p), block.size());
+    std::string_view l = block.substr(p, e - p);
+    l = l.substr(0, l.find(';'));
+    for (const auto& [open, close] : {std::pair{'{', '}'}, std::pair{'[', ']'}})
+      if (const auto a = l.find(open); a != std::string_view::npos) {
+        const auto b = l.find(close, a);
+        return std::string(l.substr(a, b == std::string_view::npos ? l.npos : b - a + 1));
+      }
+    p = e + 1;
+  }
+  return {};
+}
+
+bool on_bed(const Vec3& p, const PrintConfig& c) {
+  constexpr double eps = 1e-3;  // what %.3f may round
+  return p.x() >= c.bed_min.x() - eps && p.x() <= c.bed_max.x() + eps &&
+         p.y() >= c.bed_min.y() - eps && p.y() <= c.bed_max.y() + eps;
+}
+
+std::string bed_text(const PrintConfig& c) {
+  char buf[120];
+  std::snprintf(buf, sizeof buf, "the bed is X %g to %g, Y %g to %g", c.bed_min.x(), c.bed_max.x(),
+                c.bed_min.y(), c.bed_max.y());
+  return buf;
+}
+
+// Moves of a custom block that go off the bed. `prefix` sets the position it starts from.
+std::optional<Error> check_block_on_bed(const std::string& key, const std::string& block,
+                                        const std::string& prefix, const PrintConfig& c) {
+  auto moves = read_gcode_moves(prefix + block);
+  if (!moves) return Error{Status::invalid_argument, key + ": " + moves.error().message};
+  const int skip = static_cast<int>(std::count(prefix.begin(), prefix.end(), '\n'));
+  for (const PrintMove& m : *moves) {
+    const bool moved_xy = (m.to.head<2>() - m.from.head<2>()).norm() > 0;
+    if (!moved_xy || on_bed(m.to, c)) continue;
+    char buf[120];
+    std::snprintf(buf, sizeof buf, ": line %d goes to X%.3f Y%.3f, off the bed; ", m.line - skip,
+                  m.to.x(), m.to.y());
+    return Error{Status::invalid_argument, key + buf + bed_text(c)};
+  }
+  return std::nullopt;
+}
+
 class Emitter {
  public:
-  explicit Emitter(const PrintConfig& c) : g_(c.gcode), tip_radius_(c.toolhead.tip_radius) {}
+  explicit Emitter(const PrintConfig& c) : c_(c), g_(c.gcode), tip_radius_(c.toolhead.tip_radius) {}
   std::string out;
+  /// The first point off the bed, or a line too long to format: the program is refused.
+  std::optional<Error> fault;
+  const char* what = "the print";  ///< what is being emitted, for the fault's message
 
   void raw(const std::string& s) { out += s; }
   void comment(const std::string& s) { out += ";" + s + "\n"; }
@@ -71,8 +146,10 @@ class Emitter {
     char buf[256];
     va_list ap;
     va_start(ap, f);
-    std::vsnprintf(buf, sizeof buf, f, ap);
+    const int n = std::vsnprintf(buf, sizeof buf, f, ap);
     va_end(ap);
+    if ((n < 0 || n >= static_cast<int>(sizeof buf)) && !fault)
+      fault = Error{Status::internal_error, "a G-code line would not fit 255 characters"};
     out += buf;
     out += '\n';
   }
@@ -99,6 +176,7 @@ class Emitter {
   // On a curved layer, as travel_height says (toolhead.hpp). (Travelling at the ends' height
   // went 0.12 mm under a neighbouring line on a wave; TravelsClearPrintedMaterial found it.)
   void travel(const Vec3& p, double speed, bool curved, double safe_z, double slope) {
+    check_on_bed(p, what);  // a travel to the skirt is the skirt's problem
     if (curved && have_pos_) {
       const double d = (p.head<2>() - pos_.head<2>()).norm();
       if (d < 1e-6 && std::abs(p.z() - pos_.z()) < 1e-6) return;
@@ -136,6 +214,7 @@ class Emitter {
     pos_ = p;
   }
   void extrude(const Vec3& p, double de, double speed) {
+    check_on_bed(p, what);
     unretract();
     e_ += de;
     const double e = g_.relative_e ? de : e_;
@@ -148,10 +227,19 @@ class Emitter {
   double total_e = 0;
 
  private:
-  void move_e(double de, double speed, const char* what) {
+  void move_e(double de, double speed, const char* why) {
     e_ += de;
-    line("G1 E%.5f F%d ; %s", g_.relative_e ? de : e_, static_cast<int>(speed * 60), what);
+    line("G1 E%.5f F%d ; %s", g_.relative_e ? de : e_, static_cast<int>(speed * 60), why);
   }
+  void check_on_bed(const Vec3& p, const char* kind) {
+    if (fault || on_bed(p, c_)) return;
+    char buf[160];
+    std::snprintf(buf, sizeof buf, "%s reaches X%.3f Y%.3f, off the bed; ", kind, p.x(), p.y());
+    fault = Error{Status::invalid_argument,
+                  buf + bed_text(c_) + " (move the part, or use fewer skirts or a smaller " +
+                      "skirt_distance)"};
+  }
+  const PrintConfig& c_;
   const GcodeParams& g_;
   double tip_radius_;  ///< what a short hop must clear (travel_height)
   Vec3 pos_ = Vec3::Zero();
@@ -164,6 +252,7 @@ class Emitter {
 Expected<std::string> make_gcode(const std::vector<LayerToolpaths>& layers, const PrintConfig& c,
                                  const std::vector<std::string>& header, const Context& ctx) {
   const GcodeParams& g = c.gcode;
+  if (auto e = check_custom_gcode(c); !e) return e.error();
   Emitter em(c);
   em.out.reserve(1 << 20);
   em.comment(" generated by nonplanar 0.1.0");
@@ -172,8 +261,8 @@ Expected<std::string> make_gcode(const std::vector<LayerToolpaths>& layers, cons
   em.line("M140 S%g", g.first_layer_bed_temperature);
   em.line("M104 S%g", g.first_layer_temperature);
   const std::string start = expand(g.start_gcode, c);
-  if (start.find("M190") == std::string::npos) em.line("M190 S%g", g.first_layer_bed_temperature);
-  if (start.find("M109") == std::string::npos) em.line("M109 S%g", g.first_layer_temperature);
+  if (!has_command(start, "M190")) em.line("M190 S%g", g.first_layer_bed_temperature);
+  if (!has_command(start, "M109")) em.line("M109 S%g", g.first_layer_temperature);
   em.line("G21 ; millimetres");
   em.line("G90 ; absolute XYZ");
   em.line(g.relative_e ? "M83 ; relative E" : "M82 ; absolute E");
@@ -198,6 +287,7 @@ Expected<std::string> make_gcode(const std::vector<LayerToolpaths>& layers, cons
     bool first = true;
     for (const ExtrusionPath& p : L.paths) {
       if (p.points.size() < 2) continue;
+      em.what = p.role == ExtrusionRole::skirt ? "the skirt" : "the print";
       em.travel(p.points.front(), c.paths.travel_speed, L.nonplanar, L.max_z, L.max_slope);
       if (first || p.role != role) em.line(";TYPE:%s", role_name(p.role));
       if (first || std::abs(p.width - width) > 1e-9) em.line(";WIDTH:%.3f", p.width);
@@ -216,12 +306,31 @@ Expected<std::string> make_gcode(const std::vector<LayerToolpaths>& layers, cons
     em.retract();
     ctx.progress("gcode", static_cast<double>(i + 1) / static_cast<double>(layers.size()));
   }
+  if (em.fault) return *em.fault;
   em.fan(0);
   em.raw(expand(g.end_gcode, c));
   em.line("; filament used [mm] = %.2f", filament);
   em.line("; filament used [cm3] = %.3f",
           filament * M_PI * 0.25 * g.filament_diameter * g.filament_diameter / 1000.0);
   return std::move(em.out);
+}
+
+Expected<bool> check_custom_gcode(const PrintConfig& c) {
+  const std::string start = expand(c.gcode.start_gcode, c), end = expand(c.gcode.end_gcode, c);
+  for (const auto& [key, block] : {std::pair{"start_gcode", &start}, {"end_gcode", &end}}) {
+    const std::string left = leftover_placeholder(*block);
+    if (!left.empty())
+      return Error{Status::invalid_argument,
+                   std::string(key) + ": " + left +
+                       " is a placeholder or macro the built-in writer cannot fill in (it knows "
+                       "temperatures, layer heights and diameters); edit it out, or slice with "
+                       "--engine prusaslicer"};
+  }
+  if (auto e = check_block_on_bed("start_gcode", start, "", c)) return *e;
+  char at[80];  // the end block starts over the print, somewhere on the bed
+  std::snprintf(at, sizeof at, "G92 X%g Y%g Z10\n", c.bed_center().x(), c.bed_center().y());
+  if (auto e = check_block_on_bed("end_gcode", end, at, c)) return *e;
+  return true;
 }
 
 Expected<bool> write_gcode_file(const std::filesystem::path& file,

@@ -1,6 +1,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <string>
 
 #include "core/mesh_topology.hpp"
@@ -19,6 +20,12 @@ std::string lower_extension(const std::filesystem::path& file) {
   std::transform(ext.begin(), ext.end(), ext.begin(),
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   return ext;
+}
+
+std::string format_mm(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3g mm", v);
+  return buf;
 }
 
 Error with_file(const std::filesystem::path& file, Error e) {
@@ -85,8 +92,7 @@ Expected<LoadedMesh> load_mesh(const std::filesystem::path& file, const LoadPara
   ctx.progress("load", 0.4);
 
   out.input_triangles = raw->faces.size();
-  const BoundingBox raw_box = bounding_box(*raw);
-  out.weld_tolerance = params.weld_tolerance_rel * raw_box.size().norm();
+  out.weld_tolerance = io::weld_tolerance(*raw, params.weld_tolerance_rel);
   out.mesh = io::weld(std::move(*raw), out.weld_tolerance, &out.defects.collapsed_faces);
   raw = Error{};
   if (out.mesh.faces.empty())
@@ -117,8 +123,10 @@ Expected<LoadedMesh> load_mesh(const std::filesystem::path& file, const LoadPara
   if (d.zero_area_faces)
     out.warnings.push_back(std::to_string(d.zero_area_faces) + " zero-area faces");
   if (d.collapsed_faces)
-    out.warnings.push_back(std::to_string(d.collapsed_faces) +
-                           " degenerate faces removed by welding");
+    out.warnings.push_back(std::to_string(d.collapsed_faces) + " of " +
+                           std::to_string(out.input_triangles) +
+                           " faces were degenerate and removed by welding (tolerance " +
+                           format_mm(out.weld_tolerance) + ")");
   ctx.progress("load", 1.0);
   return out;
 }

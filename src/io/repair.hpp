@@ -8,6 +8,13 @@
 
 namespace nonplanar::io {
 
+/// The weld tolerance (mm) for a raw mesh: `rel` times the diagonal of the box around the
+/// corners of faces with non-zero area, and at most 1e-3 of the median such edge length.
+/// Unused vertices and degenerate faces do not count, so one stray point far away cannot
+/// widen the tolerance (a 4 mm tolerance once collapsed 5119 of 5248 faces); the edge cap
+/// keeps one small far-off triangle from doing it. 0 when no face has area.
+double weld_tolerance(const TriangleMesh& raw, double rel);
+
 /// Merge vertices closer than `tolerance` (mm) and drop faces that lose a corner to the
 /// merge (their count goes to *collapsed). Unreferenced vertices are removed.
 /// Exact duplicates are merged by hashing first, so only unique points meet the slower

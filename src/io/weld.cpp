@@ -2,6 +2,8 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <limits>
+#include <utility>
 #include <vector>
 
 #include "core/huge_pages.hpp"
@@ -156,6 +158,27 @@ TriangleMesh weld(TriangleMesh mesh, double tolerance, std::size_t* collapsed) {
   for (auto& f : mesh.faces)
     for (int& v : f) v = remap[v];
   return mesh;
+}
+
+double weld_tolerance(const TriangleMesh& raw, double rel) {
+  if (rel <= 0) return 0.0;
+  Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  std::vector<double> edges;  // a sample of edge lengths, for the median
+  const std::size_t stride = std::max<std::size_t>(1, raw.faces.size() / 65536);
+  for (std::size_t i = 0; i < raw.faces.size(); ++i) {
+    const auto& f = raw.faces[i];
+    const Vec3 &a = raw.vertices[f[0]], &b = raw.vertices[f[1]], &c = raw.vertices[f[2]];
+    if ((b - a).cross(c - a).squaredNorm() == 0.0) continue;  // no area: says nothing of size
+    lo = lo.cwiseMin(a).cwiseMin(b).cwiseMin(c);
+    hi = hi.cwiseMax(a).cwiseMax(b).cwiseMax(c);
+    if (i % stride == 0)
+      for (const auto& [p, q] : {std::pair{&a, &b}, std::pair{&b, &c}, std::pair{&c, &a}})
+        edges.push_back((*q - *p).norm());
+  }
+  if (edges.empty()) return 0.0;
+  auto mid = edges.begin() + static_cast<std::ptrdiff_t>(edges.size() / 2);
+  std::nth_element(edges.begin(), mid, edges.end());
+  return std::min(rel * (hi - lo).norm(), 1e-3 * *mid);
 }
 
 std::size_t count_zero_area_faces(const TriangleMesh& mesh, double tolerance) {

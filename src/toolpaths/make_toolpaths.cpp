@@ -55,7 +55,8 @@ ExtrusionPath make_path(ExtrusionRole role, double width, double speed, const Po
 
 Expected<std::vector<LayerToolpaths>> make_toolpaths(const std::vector<SlicedLayer>& layers,
                                                      const ToolpathParams& P, const Context& ctx) {
-  if (!(P.extrusion_width > 0) || !(P.external_perimeter_width > 0) || !(P.first_layer_width > 0))
+  if (!(P.extrusion_width > 0) || !(P.perimeter_width > 0) || !(P.external_perimeter_width > 0) ||
+      !(P.first_layer_width > 0))
     return Error{Status::invalid_argument, "extrusion_width: must be > 0"};
   if (!(P.fill_density >= 0 && P.fill_density <= 1))
     return Error{Status::invalid_argument, "fill_density: must be in [0, 1]"};
@@ -66,12 +67,12 @@ Expected<std::vector<LayerToolpaths>> make_toolpaths(const std::vector<SlicedLay
   tbb::parallel_for(std::size_t{0}, n, [&](std::size_t i) {
     if (stop || ctx.cancelled()) return stop = true, void();
     const double h = layers[i].z_top - layers[i].z_bottom;
-    const double w = i == 0 ? P.first_layer_width : P.extrusion_width;
+    const double wp = i == 0 ? P.first_layer_width : P.perimeter_width;
     const double we = i == 0 ? P.first_layer_width : P.external_perimeter_width;
     for (const ExPolygon& island : layers[i].islands) {
       ExPolygons inner;
       reg[i].loops.push_back(
-          paths::perimeter_loops({island}, P.perimeters, we, bead_spacing(w, h), &inner));
+          paths::perimeter_loops({island}, P.perimeters, we, bead_spacing(wp, h), &inner));
       reg[i].fill.insert(reg[i].fill.end(), inner.begin(), inner.end());
     }
   });
@@ -87,6 +88,7 @@ Expected<std::vector<LayerToolpaths>> make_toolpaths(const std::vector<SlicedLay
     const SlicedLayer& L = layers[i];
     const double h = L.z_top - L.z_bottom, z = L.z_top;
     const double w = i == 0 ? P.first_layer_width : P.extrusion_width;
+    const double wp = i == 0 ? P.first_layer_width : P.perimeter_width;
     const double we = i == 0 ? P.first_layer_width : P.external_perimeter_width;
     const double s = bead_spacing(w, h);
     auto speed = [&](double v) { return i == 0 ? std::min(v, P.first_layer_speed) : v; };
@@ -139,8 +141,8 @@ Expected<std::vector<LayerToolpaths>> make_toolpaths(const std::vector<SlicedLay
         for (const Polygon& loop : rings[r])
           g.push_back(make_path(
               r == 0 ? ExtrusionRole::external_perimeter : ExtrusionRole::perimeter,
-              r == 0 ? we : w, speed(r == 0 ? P.external_perimeter_speed : P.perimeter_speed), loop,
-              true, z, h));
+              r == 0 ? we : wp, speed(r == 0 ? P.external_perimeter_speed : P.perimeter_speed),
+              loop, true, z, h));
       if (!g.empty()) groups.push_back(std::move(g));
     }
     std::vector<ExtrusionPath> islands_paths;

@@ -165,6 +165,12 @@ TEST(HostileInput, LimitsAreErrorsNamingTheKeyOrSizes) {
   ASSERT_EQ(ok.code, 0) << ok.err;
   const std::string g = test::read_bytes(out);
   EXPECT_NE(g.find("h_min 0.120"), std::string::npos);
+  // Hostile-input #17: a max_angle just under 90 was accepted and then every slice failed
+  // the safety gate (exit 1). Now the head's cone bounds it, and the slice works.
+  const CliRun steep = cli("slice -q " + (dir / "roof.stl").string() + " -o " + out +
+                           " --max-angle 89.9 --set nozzle_cone_angle=85");
+  EXPECT_EQ(steep.code, 0) << steep.err;
+  EXPECT_NE(test::read_bytes(out).find("max_angle 85.0"), std::string::npos);
 }
 
 // Ctrl-C at several moments of a long slice (the bunny takes about 10 s here): the run ends

@@ -163,6 +163,71 @@ TEST(PlanarPrint, PrusaSlicerIniReachesTheGcode) {
   EXPECT_NEAR(p.prog.layer_z[1] - p.prog.layer_z[0], 0.15, 1e-9);
 }
 
+// Hostile-input #6: a 215 mm part on the 220 mm bed got a skirt from X -3.75 to 223.75.
+TEST(PlanarPrint, NothingLeavesTheBed) {
+  PrintConfig c;
+  TriangleMesh wide = test::box({0, 0, 0}, {215, 20, 1});
+  const BoundingBox b = bounding_box(wide);
+  for (Vec3& v : wide.vertices) v += Vec3(110 - 0.5 * b.max.x(), 100, 0);
+  auto layers = slice_mesh(wide, c.slice, {});
+  ASSERT_TRUE(layers);
+  auto paths = make_toolpaths(*layers, c.paths, {});
+  ASSERT_TRUE(paths);
+  auto refused = make_gcode(*paths, c, {}, {});
+  ASSERT_FALSE(refused);
+  EXPECT_EQ(refused.error().status, Status::invalid_argument);
+  EXPECT_NE(refused.error().message.find("the skirt reaches X"), std::string::npos)
+      << refused.error().message;
+  c.paths.skirts = 0;  // without it every move stays on the bed
+  auto paths0 = make_toolpaths(*layers, c.paths, {});
+  ASSERT_TRUE(paths0);
+  auto ok = make_gcode(*paths0, c, {}, {});
+  ASSERT_TRUE(ok) << ok.error().message;
+  const test::Program prog = test::read_gcode(*ok);
+  ASSERT_EQ(prog.error, "");
+  for (const auto& m : prog.moves) {
+    EXPECT_GE(m.to.x(), 0.0);
+    EXPECT_LE(m.to.x(), 220.0);
+  }
+}
+
+// Hostile-input #5: a comment that mentions M190 dropped our wait for the bed, and an
+// unknown placeholder reached the printer raw.
+TEST(PlanarPrint, CustomGcodeIsCheckedNotPassedRaw) {
+  const Printed base = print(test::box({0, 0, 0}, {10, 10, 1}), PrintConfig{});
+  auto start_of = [](const std::string& start) {
+    PrintConfig c;
+    c.gcode.start_gcode = start;
+    return c;
+  };
+  const Printed commented =
+      print(test::box({0, 0, 0}, {10, 10, 1}), start_of("G28 ; M190 and M109 come later\n"));
+  EXPECT_NE(commented.text.find("\nM190 S60\n"), std::string::npos);
+  EXPECT_NE(commented.text.find("\nM109 S215\n"), std::string::npos);
+  const Printed own = print(test::box({0, 0, 0}, {10, 10, 1}), start_of("M190 S70\nG28\n"));
+  EXPECT_EQ(own.text.find("M190 S60"), std::string::npos);  // the profile waits itself
+  EXPECT_NE(own.text.find("M109 S215"), std::string::npos);
+  EXPECT_TRUE(check_custom_gcode(start_of("G28 ; [printer_model] {if x}\n")));
+  for (const char* bad : {"G1 Z{max_layer_z}\n", "M862.3 P \"[printer_model]\"\n",
+                          "{if layer_height<0.075}M221 S100{else}M221 S95{endif}\n"}) {
+    auto r = check_custom_gcode(start_of(bad));
+    ASSERT_FALSE(r) << bad;
+    EXPECT_EQ(r.error().message.rfind("start_gcode: ", 0), 0u) << r.error().message;
+  }
+  PrintConfig end;
+  end.gcode.end_gcode = "G1 X0 Y200 Z{max_layer_z}\n";
+  EXPECT_FALSE(check_custom_gcode(end));
+  // The default purge on a 180 mm bed, given as text the way an old profile carries it.
+  PrintConfig small = start_of(PrintConfig{}.gcode.start_gcode);
+  small.bed_max = Vec2(180, 180);
+  auto off = check_custom_gcode(small);
+  ASSERT_FALSE(off);
+  EXPECT_NE(off.error().message.find("line 5 goes to X2.000 Y200.000, off the bed"),
+            std::string::npos)
+      << off.error().message;
+  EXPECT_NE(base.text.find("G1 Y200 E15 F1200 ; purge line"), std::string::npos);
+}
+
 TEST(Config, BadValuesNameTheKeyAndLine) {
   auto r = parse_ini_config("layer_height = 0.2\nfill_density = lots\n");
   ASSERT_FALSE(r);

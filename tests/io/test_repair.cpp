@@ -1,6 +1,8 @@
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <random>
+#include <sstream>
 
 #include "io/repair.hpp"
 #include "support/files.hpp"
@@ -47,6 +49,59 @@ TEST(Weld, DropsCollapsedFacesAndUnusedVertices) {
   EXPECT_EQ(collapsed, 1u);
   EXPECT_EQ(w.faces.size(), 12u);
   EXPECT_EQ(w.vertices.size(), 8u);
+}
+
+// Hostile-input #3: a stray unused vertex or a far-off degenerate facet set the tolerance
+// to 4 mm and collapsed most of the part. Neither may count now.
+TEST(Weld, StrayPointsDoNotSetTheTolerance) {
+  const TriangleMesh sphere = test::icosphere(Vec3(0, 0, 0), 10.0, 3);  // 1280 faces
+  const double good = io::weld_tolerance(sphere, 1e-6);
+  EXPECT_NEAR(good, 1e-6 * std::sqrt(3.0) * 20.0, 1e-7);  // the sphere's own box
+
+  TriangleMesh stray = sphere;
+  stray.vertices.push_back(Vec3(4e6, 0, 0));  // unused, as an OBJ may list it
+  EXPECT_DOUBLE_EQ(io::weld_tolerance(stray, 1e-6), good);
+
+  TriangleMesh needle = sphere;  // a zero-area facet 4 km off, as a broken STL may hold
+  const int b = static_cast<int>(needle.vertices.size());
+  needle.vertices.insert(needle.vertices.end(),
+                         {Vec3(4e6, 0, 0), Vec3(4e6, 0, 0), Vec3(4e6, 1, 0)});
+  needle.faces.push_back({b, b + 1, b + 2});
+  EXPECT_DOUBLE_EQ(io::weld_tolerance(needle, 1e-6), good);
+
+  TriangleMesh speck = sphere;  // a real 1 mm triangle 4 km off: the edge cap holds
+  const int c = static_cast<int>(speck.vertices.size());
+  speck.vertices.insert(speck.vertices.end(),
+                        {Vec3(4e6, 0, 0), Vec3(4e6 + 1, 0, 0), Vec3(4e6, 1, 0)});
+  speck.faces.push_back({c, c + 1, c + 2});
+  const double capped = io::weld_tolerance(speck, 1e-6);
+  EXPECT_LT(capped, 2e-3);  // the box alone would give 4 mm
+  std::size_t collapsed = 99;
+  const TriangleMesh w = io::weld(soup(speck, 0, 1), capped, &collapsed);
+  EXPECT_EQ(collapsed, 0u);
+  EXPECT_EQ(w.faces.size(), speck.faces.size());
+  EXPECT_EQ(io::weld_tolerance(
+                TriangleMesh{{Vec3(0, 0, 0), Vec3(1, 1, 1), Vec3(2, 2, 2)}, {{0, 1, 2}}}, 1e-6),
+            0.0);  // collinear only: no size to take
+}
+
+TEST(Weld, LoaderKeepsThePartWithAFarUnusedObjVertex) {
+  const TriangleMesh sphere = test::icosphere(Vec3(0, 0, 10), 10.0, 3);
+  std::ostringstream obj;
+  obj.precision(17);
+  for (const Vec3& v : sphere.vertices)
+    obj << "v " << v.x() << ' ' << v.y() << ' ' << v.z() << '\n';
+  obj << "v 4000000 0 0\n";
+  for (const auto& f : sphere.faces)
+    obj << "f " << f[0] + 1 << ' ' << f[1] + 1 << ' ' << f[2] + 1 << '\n';
+  const auto dir = test::temp_dir("weld_stray");
+  test::write_bytes(dir / "stray.obj", obj.str());
+  auto r = load_mesh(dir / "stray.obj", {}, {});
+  ASSERT_TRUE(r) << r.error().message;
+  EXPECT_EQ(r->mesh.faces.size(), 1280u);
+  EXPECT_EQ(r->defects.collapsed_faces, 0u);
+  EXPECT_NEAR(signed_volume(r->mesh), signed_volume(sphere), 1e-9);
+  EXPECT_LT(r->weld_tolerance, 1e-4);
 }
 
 TEST(Orientation, FixesFlippedFacesAndInvertedShells) {

@@ -1,10 +1,10 @@
-// Strict G-code reader for check and for mapping foreign G-code.
+// Strict G-code reader for check, for mapping foreign G-code and for the writer's own
+// custom blocks.
 #include <charconv>
 #include <cmath>
 #include <string>
 
 #include "io/mesh_buffer.hpp"
-#include "nonplanar/check.hpp"
 #include "nonplanar/gcode.hpp"
 
 namespace nonplanar {
