@@ -75,7 +75,7 @@ Expected<LoadedMesh> load_mesh(const std::filesystem::path& file, const LoadPara
     raw = io::parse_off(data);
   } else {
     out.format = MeshFormat::threemf;
-    raw = io::parse_3mf(data);
+    raw = io::parse_3mf(data, params.max_triangles);
   }
   *bytes = io::FileBytes();  // unmap
   if (!raw) return with_file(file, raw.error());

@@ -19,7 +19,9 @@ Expected<TriangleMesh> parse_obj(std::string_view data);
 /// OFF (also COFF/NOFF headers): extra per-vertex or per-face values are ignored.
 Expected<TriangleMesh> parse_off(std::string_view data);
 
-/// 3MF through lib3mf: every build item, components resolved, transforms applied.
-Expected<TriangleMesh> parse_3mf(std::string_view data);
+/// 3MF through lib3mf: every build item, components resolved, transforms applied, in mm
+/// whatever the model's `unit` (micron … meter). Triangles are counted before any is built:
+/// more than `max_triangles` is an invalid_mesh error. A non-finite transform is an error.
+Expected<TriangleMesh> parse_3mf(std::string_view data, std::size_t max_triangles = 50'000'000);
 
 }  // namespace nonplanar::io

@@ -1,6 +1,8 @@
 #include <Model/COM/NMR_DLLInterfaces.h>
 #include <gtest/gtest.h>
 
+#include <limits>
+
 #include "io/readers.hpp"
 #include "support/files.hpp"
 #include "support/solids.hpp"
@@ -80,6 +82,106 @@ TEST(ThreeMfErrors, ZipThatIsNot3mfAndRandomBytes) {
   EXPECT_NE(r.error().message.find("not a valid 3MF"), std::string::npos) << r.error().message;
   EXPECT_FALSE(io::parse_3mf("this is not a zip at all"));
   EXPECT_FALSE(io::parse_3mf(""));
+}
+
+// A cube mesh object in a fresh lib3mf model (released by the caller with the model).
+NMR::PLib3MFModelMeshObject* add_cube(NMR::PLib3MFModel* model) {
+  const TriangleMesh cube = test::box({0, 0, 0}, {1, 1, 1});
+  NMR::PLib3MFModelMeshObject* obj = nullptr;
+  EXPECT_EQ(NMR::lib3mf_model_addmeshobject(model, &obj), 0);
+  std::vector<NMR::MODELMESHVERTEX> v(cube.vertices.size());
+  for (std::size_t i = 0; i < v.size(); ++i)
+    for (int k = 0; k < 3; ++k) v[i].m_fPosition[k] = static_cast<float>(cube.vertices[i][k]);
+  std::vector<NMR::MODELMESHTRIANGLE> t(cube.faces.size());
+  for (std::size_t i = 0; i < t.size(); ++i)
+    for (int k = 0; k < 3; ++k) t[i].m_nIndices[k] = static_cast<DWORD>(cube.faces[i][k]);
+  EXPECT_EQ(NMR::lib3mf_meshobject_setgeometry(obj, v.data(), static_cast<DWORD>(v.size()),
+                                               t.data(), static_cast<DWORD>(t.size())),
+            0);
+  return obj;
+}
+
+std::string write_model(NMR::PLib3MFModel* model, const std::filesystem::path& file) {
+  NMR::PLib3MFModelWriter* writer = nullptr;
+  EXPECT_EQ(NMR::lib3mf_model_querywriter(model, "3mf", &writer), 0);
+  EXPECT_EQ(NMR::lib3mf_writer_writetofileutf8(writer, file.c_str()), 0);
+  NMR::lib3mf_release(writer);
+  return test::read_bytes(file);
+}
+
+NMR::MODELTRANSFORM identity() {
+  NMR::MODELTRANSFORM m{};
+  for (int k = 0; k < 3; ++k) m.m_fFields[k][k] = 1;
+  return m;
+}
+
+// Hostile-input #9: nested components that expand past the triangle limit are refused after
+// counting, before anything is built (the old reader built 5.5 GB first). 7 levels of 10
+// components of a 12-triangle cube: 1.2e8 triangles, from a file of a few KB. (lib3mf's own
+// reader walks the expanded tree once per object: 9 levels take it 37 s before we count.)
+TEST(ThreeMfErrors, ComponentBombIsCountedNotBuilt) {
+  const auto dir = test::temp_dir("3mf_bomb");
+  NMR::PLib3MFModel* model = nullptr;
+  ASSERT_EQ(NMR::lib3mf_createmodel(&model), 0);
+  NMR::PLib3MFModelObjectResource* level = add_cube(model);
+  for (int depth = 0; depth < 7; ++depth) {
+    NMR::PLib3MFModelComponentsObject* up = nullptr;
+    ASSERT_EQ(NMR::lib3mf_model_addcomponentsobject(model, &up), 0);
+    for (int i = 0; i < 10; ++i) {
+      NMR::MODELTRANSFORM m = identity();
+      m.m_fFields[0][3] = static_cast<float>(i);
+      NMR::PLib3MFModelComponent* c = nullptr;
+      ASSERT_EQ(NMR::lib3mf_componentsobject_addcomponent(up, level, &m, &c), 0);
+      NMR::lib3mf_release(c);
+    }
+    level = up;
+  }
+  NMR::PLib3MFModelBuildItem* item = nullptr;
+  ASSERT_EQ(NMR::lib3mf_model_addbuilditem(model, level, nullptr, &item), 0);
+  const std::string bytes = write_model(model, dir / "bomb.3mf");
+  NMR::lib3mf_release(item);
+  NMR::lib3mf_release(model);
+  EXPECT_LT(bytes.size(), 20000u);
+  auto r = io::parse_3mf(bytes);
+  ASSERT_FALSE(r);
+  EXPECT_EQ(r.error().status, Status::invalid_mesh);
+  EXPECT_NE(r.error().message.find("1.2e+08 triangles"), std::string::npos) << r.error().message;
+}
+
+// Hostile-input #12: a NaN transform got through (analyze: "volume nan"), and the unit
+// attribute was ignored.
+TEST(ThreeMfErrors, NonFiniteTransformsAndUnits) {
+  const auto dir = test::temp_dir("3mf_units");
+  for (const auto& [unit, mm] : {std::pair{NMR::MODELUNIT_INCH, 25.4},
+                                 {NMR::MODELUNIT_MICROMETER, 0.001},
+                                 {NMR::MODELUNIT_CENTIMETER, 10.0},
+                                 {NMR::MODELUNIT_MILLIMETER, 1.0}}) {
+    NMR::PLib3MFModel* model = nullptr;
+    ASSERT_EQ(NMR::lib3mf_createmodel(&model), 0);
+    ASSERT_EQ(NMR::lib3mf_model_setunit(model, unit), 0);
+    auto* cube = add_cube(model);
+    NMR::PLib3MFModelBuildItem* item = nullptr;
+    ASSERT_EQ(NMR::lib3mf_model_addbuilditem(model, cube, nullptr, &item), 0);
+    const std::string bytes = write_model(model, dir / "u.3mf");
+    for (auto* p : {static_cast<NMR::PLib3MFBase*>(item), cube, model}) NMR::lib3mf_release(p);
+    auto r = io::parse_3mf(bytes);
+    ASSERT_TRUE(r) << r.error().message;
+    EXPECT_NEAR(signed_volume(*r), mm * mm * mm, 1e-9 * mm * mm * mm) << unit;
+    EXPECT_TRUE(io::parse_3mf(bytes, 12));  // the count is exact: 12 triangles
+    EXPECT_FALSE(io::parse_3mf(bytes, 11));
+  }
+  NMR::PLib3MFModel* model = nullptr;
+  ASSERT_EQ(NMR::lib3mf_createmodel(&model), 0);
+  auto* cube = add_cube(model);
+  NMR::MODELTRANSFORM m = identity();
+  m.m_fFields[1][1] = std::numeric_limits<float>::quiet_NaN();
+  NMR::PLib3MFModelBuildItem* item = nullptr;
+  ASSERT_EQ(NMR::lib3mf_model_addbuilditem(model, cube, &m, &item), 0);
+  const std::string bytes = write_model(model, dir / "nan.3mf");
+  for (auto* p : {static_cast<NMR::PLib3MFBase*>(item), cube, model}) NMR::lib3mf_release(p);
+  auto r = io::parse_3mf(bytes);
+  ASSERT_FALSE(r) << "a NaN transform was read";
+  EXPECT_NE(r.error().message.find("not finite"), std::string::npos) << r.error().message;
 }
 
 }  // namespace
