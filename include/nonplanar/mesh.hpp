@@ -52,13 +52,14 @@ struct MeshDefects {
   std::size_t inconsistent_edges = 0;  ///< manifold edges whose two faces disagree on winding
   std::size_t zero_area_faces = 0;     ///< faces whose height is below the weld tolerance
   std::size_t collapsed_faces = 0;     ///< faces dropped because welding merged two corners
+  std::size_t duplicate_faces = 0;     ///< faces dropped as copies of another, same winding
   std::size_t shells = 0;              ///< connected components
   std::size_t faces_flipped = 0;       ///< faces whose winding the loader reversed
   bool was_inverted = false;           ///< a whole shell pointed inward and was flipped
   bool closed() const { return open_edges == 0 && non_manifold_edges == 0; }
   bool any() const {
     return open_edges || non_manifold_edges || inconsistent_edges || zero_area_faces ||
-           collapsed_faces || was_inverted;
+           collapsed_faces || duplicate_faces || was_inverted;
   }
 };
 

@@ -54,6 +54,25 @@ SliceJob make_job(const PrintConfig& print, double max_angle_deg) {
 
 namespace {
 
+// A part thinner than one extrusion, or an open sheet, slices to nothing: say so rather than
+// write G-code that only draws a skirt (a lone sloped triangle once gave exit 0, a header
+// claiming 274 core layers, and no extrusion).
+std::optional<Error> nothing_to_print(const SliceResult& r, const TriangleMesh& mesh) {
+  const bool prints = std::any_of(r.layers.begin(), r.layers.end(), [](const LayerToolpaths& L) {
+    return std::any_of(L.paths.begin(), L.paths.end(), [](const ExtrusionPath& p) {
+      return p.role != ExtrusionRole::skirt && p.points.size() >= 2;
+    });
+  });
+  if (prints) return std::nullopt;
+  const BoundingBox b = bounding_box(mesh);
+  char buf[240];
+  std::snprintf(buf, sizeof buf,
+                "nothing to print: the part (%.2f x %.2f x %.2f mm) holds no volume one "
+                "extrusion can fill (smaller than a line, or an open surface)",
+                b.size().x(), b.size().y(), b.size().z());
+  return Error{Status::invalid_mesh, buf};
+}
+
 // Safety (DESIGN.md §3) on r.layers, rounded first to the µm they are written with (so
 // `check` on the file agrees with this gate even for a point at the collision depth's edge):
 // thickness and slope from the paths themselves, collisions with earlier layers from the
@@ -230,23 +249,6 @@ Expected<SliceResult> attempt(const TriangleMesh& mesh, const SliceJob& job, con
       r.layers = std::move(*mapped);
     }
   }
-  // A part thinner than one extrusion slices to nothing: say so rather than write G-code
-  // that only draws a skirt.
-  const bool prints = std::any_of(r.layers.begin(), r.layers.end(), [](const LayerToolpaths& L) {
-    return std::any_of(L.paths.begin(), L.paths.end(), [](const ExtrusionPath& p) {
-      return p.role != ExtrusionRole::skirt && p.points.size() >= 2;
-    });
-  });
-  if (!prints) {
-    const BoundingBox b = bounding_box(mesh);
-    char buf[200];
-    std::snprintf(buf, sizeof buf,
-                  "nothing to print: the part (%.2f x %.2f x %.2f mm) is smaller than one "
-                  "extrusion",
-                  b.size().x(), b.size().y(), b.size().z());
-    return Error{Status::invalid_mesh, buf};
-  }
-
   // The band a location belongs to: the one whose blend weight β is largest there (the
   // stacks and the field's bands are in the same order).
   const auto* banded = dynamic_cast<const layers::BandedField*>(r.plan.field.get());
@@ -416,7 +418,9 @@ Expected<SliceResult> slice_rounds(const TriangleMesh& mesh, const SliceJob& job
 Expected<SliceResult> slice_model(const TriangleMesh& mesh, const SliceJob& job,
                                   const Context& ctx) {
   auto r = slice_rounds(mesh, job, ctx);
-  if (r) r->notices.insert(r->notices.begin(), job.notices.begin(), job.notices.end());
+  if (!r) return r;
+  if (auto e = nothing_to_print(*r, mesh)) return *e;
+  r->notices.insert(r->notices.begin(), job.notices.begin(), job.notices.end());
   return r;
 }
 

@@ -95,6 +95,7 @@ Expected<LoadedMesh> load_mesh(const std::filesystem::path& file, const LoadPara
   out.weld_tolerance = io::weld_tolerance(*raw, params.weld_tolerance_rel);
   out.mesh = io::weld(std::move(*raw), out.weld_tolerance, &out.defects.collapsed_faces);
   raw = Error{};
+  out.defects.duplicate_faces = io::remove_duplicate_faces(out.mesh);
   if (out.mesh.faces.empty())
     return with_file(file, {Status::invalid_mesh, "every triangle is degenerate"});
   out.weld_tolerance *= params.scale;
@@ -122,6 +123,9 @@ Expected<LoadedMesh> load_mesh(const std::filesystem::path& file, const LoadPara
   if (d.was_inverted) out.warnings.push_back("mesh was inside out (normals flipped)");
   if (d.zero_area_faces)
     out.warnings.push_back(std::to_string(d.zero_area_faces) + " zero-area faces");
+  if (d.duplicate_faces)
+    out.warnings.push_back(std::to_string(d.duplicate_faces) +
+                           " duplicate faces removed (copies of another face)");
   if (d.collapsed_faces)
     out.warnings.push_back(std::to_string(d.collapsed_faces) + " of " +
                            std::to_string(out.input_triangles) +

@@ -21,6 +21,11 @@ double weld_tolerance(const TriangleMesh& raw, double rel);
 /// tolerant grid search; O(V) expected.
 TriangleMesh weld(TriangleMesh mesh, double tolerance, std::size_t* collapsed);
 
+/// Removes faces that repeat another face with the same winding (an STL may hold a part twice
+/// over, or one facet 96k times: every later stage pays for each copy). A face and its
+/// reverse are both kept. Returns how many were removed; the vertices are left as they are.
+std::size_t remove_duplicate_faces(TriangleMesh& mesh);
+
 /// Faces whose height over their longest edge is below `tolerance` (needles and caps).
 std::size_t count_zero_area_faces(const TriangleMesh& mesh, double tolerance);
 

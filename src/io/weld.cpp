@@ -181,6 +181,31 @@ double weld_tolerance(const TriangleMesh& raw, double rel) {
   return std::min(rel * (hi - lo).norm(), 1e-3 * *mid);
 }
 
+std::size_t remove_duplicate_faces(TriangleMesh& mesh) {
+  // A face's key: its corners rotated to start at the smallest, so the winding is kept.
+  auto key = [](std::array<int, 3> f) {
+    std::rotate(f.begin(), std::min_element(f.begin(), f.end()), f.end());
+    return f;
+  };
+  auto hash = [](const std::array<int, 3>& k) {
+    return mix(static_cast<std::uint64_t>(static_cast<std::uint32_t>(k[0])) ^
+               mix(static_cast<std::uint64_t>(static_cast<std::uint32_t>(k[1])) << 32 ^
+                   static_cast<std::uint32_t>(k[2])));
+  };
+  IndexTable table(mesh.faces.size());
+  std::size_t kept = 0;
+  for (std::size_t i = 0; i < mesh.faces.size(); ++i) {
+    const std::array<int, 3> k = key(mesh.faces[i]);
+    const std::size_t s = table.probe(hash(k), [&](int o) { return key(mesh.faces[o]) == k; });
+    if (table.slot(s) >= 0) continue;  // the same face, wound the same way, again
+    mesh.faces[kept] = mesh.faces[i];
+    table.slot(s) = static_cast<int>(kept++);
+  }
+  const std::size_t removed = mesh.faces.size() - kept;
+  mesh.faces.resize(kept);
+  return removed;
+}
+
 std::size_t count_zero_area_faces(const TriangleMesh& mesh, double tolerance) {
   std::size_t n = 0;
   for (const auto& f : mesh.faces) {

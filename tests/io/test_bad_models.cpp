@@ -13,23 +13,23 @@ namespace {
 
 struct Expect {
   const char* file;
-  std::size_t faces, open, non_manifold, inconsistent, zero_area, collapsed, shells, flipped;
+  std::size_t faces, open, non_manifold, inconsistent, zero_area, collapsed, dup, shells, flipped;
   bool inverted;
 };
 
 const Expect kExpect[] = {
-    // file                                     faces open nm  inc   zero coll shells flip inv
-    {"bad_aaron_mouse_nonmanifold.stl", 256, 0, 0, 0, 0, 4, 1, 0, false},
-    {"bad_assimp_Spider_binary.stl", 1312, 72, 0, 10, 0, 56, 18, 4, false},
-    {"bad_assimp_sphereWithHole.stl", 285, 9, 0, 0, 0, 0, 1, 0, false},
-    {"bad_cgal_blobby-shuffled.off", 4050, 0, 0, 3069, 0, 0, 1, 2017, false},
-    {"bad_cgal_elephant-with-holes.off", 4463, 1353, 0, 0, 0, 0, 1, 0, false},
-    {"bad_cgal_ellipsoid_inverted.off", 3108, 0, 0, 0, 0, 0, 1, 3108, true},
-    {"bad_manifold_openscad-nonmanifold-crash.obj", 1436, 0, 19, 0, 34, 6, 1, 0, false},
-    {"bad_manifold_self_intersectA.obj", 17160, 0, 0, 0, 0, 0, 1, 0, false},
-    {"bad_openscad_back-to-back.stl", 10, 0, 2, 0, 2, 0, 1, 0, false},
-    {"bad_openscad_bad-stl-wing.stl", 842, 0, 0, 0, 24, 0, 1, 0, false},
-    {"bad_openscad_zero-area-triangle.stl", 14, 0, 0, 0, 1, 0, 1, 0, false},
+    // file                                     faces open nm  inc   zero coll dup shells flip inv
+    {"bad_aaron_mouse_nonmanifold.stl", 256, 0, 0, 0, 0, 4, 0, 1, 0, false},
+    {"bad_assimp_Spider_binary.stl", 1312, 72, 0, 10, 0, 56, 0, 18, 4, false},
+    {"bad_assimp_sphereWithHole.stl", 285, 9, 0, 0, 0, 0, 0, 1, 0, false},
+    {"bad_cgal_blobby-shuffled.off", 4050, 0, 0, 3069, 0, 0, 0, 1, 2017, false},
+    {"bad_cgal_elephant-with-holes.off", 4463, 1353, 0, 0, 0, 0, 0, 1, 0, false},
+    {"bad_cgal_ellipsoid_inverted.off", 3108, 0, 0, 0, 0, 0, 0, 1, 3108, true},
+    {"bad_manifold_openscad-nonmanifold-crash.obj", 1435, 0, 19, 0, 34, 6, 1, 1, 0, false},
+    {"bad_manifold_self_intersectA.obj", 17160, 0, 0, 0, 0, 0, 0, 1, 0, false},
+    {"bad_openscad_back-to-back.stl", 10, 0, 2, 0, 2, 0, 0, 1, 0, false},
+    {"bad_openscad_bad-stl-wing.stl", 842, 0, 0, 0, 24, 0, 0, 1, 0, false},
+    {"bad_openscad_zero-area-triangle.stl", 14, 0, 0, 0, 1, 0, 0, 1, 0, false},
 };
 
 // Readable test names in ctest output instead of the struct's bytes.
@@ -52,6 +52,7 @@ TEST_P(BadModel, LoadsWithExactDefectsAndAnalyses) {
   EXPECT_EQ(d.inconsistent_edges, e.inconsistent);
   EXPECT_EQ(d.zero_area_faces, e.zero_area);
   EXPECT_EQ(d.collapsed_faces, e.collapsed);
+  EXPECT_EQ(d.duplicate_faces, e.dup);
   EXPECT_EQ(d.shells, e.shells);
   EXPECT_EQ(d.faces_flipped, e.flipped);
   EXPECT_EQ(d.was_inverted, e.inverted);

@@ -104,6 +104,19 @@ TEST(Weld, LoaderKeepsThePartWithAFarUnusedObjVertex) {
   EXPECT_LT(r->weld_tolerance, 1e-4);
 }
 
+TEST(Weld, DuplicateFacesGoTheirReverseStays) {
+  TriangleMesh m = test::box({0, 0, 0}, {1, 1, 1});
+  const auto faces = m.faces;
+  for (auto f : faces) {
+    m.faces.push_back({f[1], f[2], f[0]});  // the same face, rotated: a duplicate
+    m.faces.push_back({f[0], f[2], f[1]});  // its reverse: kept
+  }
+  EXPECT_EQ(io::remove_duplicate_faces(m), 12u);
+  EXPECT_EQ(m.faces.size(), 24u);
+  const std::vector<std::array<int, 3>> first(m.faces.begin(), m.faces.begin() + 12);
+  EXPECT_EQ(first, faces);
+}
+
 TEST(Orientation, FixesFlippedFacesAndInvertedShells) {
   TriangleMesh m = test::icosphere({0, 0, 0}, 5.0, 2);
   const double v = signed_volume(m);
