@@ -40,7 +40,14 @@ int run(const CheckOptions& o) {
   if (!mesh) return finish_progress(), report_error(mesh.error());
   auto f = check_print(*moves, &mesh->mesh, params, ctx);
   finish_progress();
-  if (!f) return report_error(f.error());
+  if (!f) return report_error({f.error().status, o.gcode + ": " + f.error().message});
+  // All figures 0 would read as a pass: an empty file, one without ;LAYER_CHANGE, lowercase
+  // or CR-only lines measure nothing, and say so.
+  if (f->extrusions == 0)
+    return report_error({Status::invalid_argument,
+                         o.gcode + ": no extrusion after a ;LAYER_CHANGE comment, so nothing "
+                                   "was measured (check reads the G-code of nonplanar, "
+                                   "PrusaSlicer and OrcaSlicer)"});
   if (o.json) {
     nlohmann::ordered_json j = {
         {"gcode", o.gcode},

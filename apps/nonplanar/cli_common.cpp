@@ -10,6 +10,7 @@
 #include <filesystem>
 
 #include "core/atomic_file.hpp"
+#include "slice/external_engine.hpp"
 
 namespace nonplanar::cli {
 namespace {
@@ -17,10 +18,14 @@ bool g_progress_drawn = false;
 std::atomic<bool> g_interrupted{false};
 
 // First Ctrl-C (or SIGTERM): ask the stages to stop; they return Status::cancelled and the
-// atomic writer removes its temporary. A second one: remove the temporary and leave now.
+// atomic writer removes its temporary. A second one: kill a running engine, or else remove the
+// temporary and leave now.
 // Only async-signal-safe calls here (unlink, write, _exit).
 extern "C" void on_interrupt(int) {
   if (g_interrupted.exchange(true)) {
+    // An engine running: kill it; its run returns at once, removes its folder and reports
+    // the interruption (leaving now would orphan both).
+    if (kill_running_engine()) return;
     remove_pending_temporary_file();
     constexpr char msg[] = "\nerror: interrupted\n";
     (void)!::write(STDERR_FILENO, msg, sizeof msg - 1);

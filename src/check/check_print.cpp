@@ -7,6 +7,7 @@
 // z(q) − z(p) − max(0, |q − p| − r)·tan α (cone) or z(q) − z(p) − H (block).
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <optional>
 #include <tuple>
 #include <unordered_map>
@@ -298,6 +299,8 @@ CheckParams check_params(const PrintConfig& print, double max_angle_deg) {
   return cp;
 }
 
+constexpr double kMaxSpan = 2000.0;  // mm: larger than any bed we know; 2.4 GB of grid at most
+
 Expected<CheckFigures> check_print(const std::vector<PrintMove>& moves, const TriangleMesh* mesh,
                                    const CheckParams& cp, const Context& ctx) {
   CheckFigures f;
@@ -316,6 +319,16 @@ Expected<CheckFigures> check_print(const std::vector<PrintMove>& moves, const Tr
     const int n = std::max(1, static_cast<int>(std::ceil(len / 0.2)));
     lo = lo.cwiseMin(m.from.head<2>().cwiseMin(m.to.head<2>()));
     hi = hi.cwiseMax(m.from.head<2>().cwiseMax(m.to.head<2>()));
+    // The grids below hold 0.2 mm cells over the extrusions' box: one move 10 m off once
+    // asked for 6.8 GB. Checked before this move is sampled.
+    if ((hi - lo).maxCoeff() > kMaxSpan) {
+      char buf[200];
+      std::snprintf(buf, sizeof buf,
+                    "line %d: extrusions span %.0f x %.0f mm; check measures prints up to %.0f mm "
+                    "across (a move far off the bed?)",
+                    m.line, hi.x() - lo.x(), hi.y() - lo.y(), kMaxSpan);
+      return Error{Status::invalid_argument, buf};
+    }
     f.extrusions += static_cast<std::size_t>(n);
     if (!cp.collisions_only)
       for (int k = 1; k <= n; ++k)

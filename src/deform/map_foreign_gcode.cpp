@@ -467,7 +467,10 @@ Expected<ForeignGcode> map_foreign_gcode(std::string_view text, const LayerField
         else if (a == 'Z')
           m.to.z() = rel_xyz ? m.to.z() + *v : *v, m.has_z = true;
         else if (a == 'E')
-          m.has_e = true, m.de = rel_e ? *v : *v - e, e = rel_e ? e + *v : *v;
+          // G91 makes E relative too, as M83 does (Klipper, RepRapFirmware, Marlin 1 and
+          // PrusaSlicer's viewer; read as absolute, a G91 retraction became 75x extrusion).
+          m.has_e = true, m.de = rel_e || rel_xyz ? *v : *v - e,
+          e = rel_e || rel_xyz ? e + *v : *v;
         else if (a == 'F')
           m.f = *v;
         else if (in_print)

@@ -84,8 +84,11 @@ Expected<std::vector<PrintMove>> read_gcode_moves(std::string_view text) {
           }
         }
         if (has_e) {
-          m.filament = rel_e ? ev : ev - e;
-          e = rel_e ? e + ev : ev;
+          // G91 makes E relative too (Klipper, RepRapFirmware, Marlin 1, PrusaSlicer's
+          // G-code viewer), as M83 does.
+          const bool rel = rel_e || rel_xyz;
+          m.filament = rel ? ev : ev - e;
+          e = rel ? e + ev : ev;
         }
         m.to = to;
         m.extruding = m.filament > 0 && (to.head<2>() - pos.head<2>()).norm() > 1e-9;

@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -41,6 +42,34 @@ struct TempDir {
     if (!path.empty()) fs::remove_all(path, ec);
   }
 };
+
+// The engine's process group while it runs (its own group, so that a terminal's Ctrl-C
+// reaches us, not it, and we stop it with everything it started), for kill_running_engine().
+std::atomic<pid_t> g_engine_group{0};
+
+// Stops the engine's whole group: SIGTERM, and SIGKILL if it has not gone within 3 s (an
+// engine that ignored SIGTERM once kept running, and kept its folder, after Ctrl-C).
+void stop_engine(pid_t pid, int* status) {
+  ::kill(-pid, SIGTERM);
+  for (int i = 0; i < 150; ++i) {
+    if (waitpid(pid, status, WNOHANG) == pid) return;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  ::kill(-pid, SIGKILL);
+  waitpid(pid, status, 0);
+}
+
+// Did the engine write its file to the end? Every libslic3r slicer writes its statistics
+// or config block after the last layer; a file without them stopped early (a crashed or
+// killed engine, a full disk) and must not reach a printer with its heaters left on.
+bool ends_complete(const std::string& text) {
+  const auto last = text.rfind(";LAYER_CHANGE");
+  if (last == std::string::npos) return false;
+  for (const char* end : {"; filament used", "; prusaslicer_config = end", "; CONFIG_BLOCK_END",
+                          "; EXECUTABLE_BLOCK_END"})
+    if (text.find(end, last) != std::string::npos) return true;
+  return false;
+}
 
 std::string last_line(const fs::path& log) {
   std::ifstream in(log);
@@ -195,9 +224,18 @@ Expected<std::string> run_engine(const EngineParams& e, const TriangleMesh& mesh
   posix_spawn_file_actions_addopen(&fa, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
   posix_spawn_file_actions_adddup2(&fa, 1, 2);
   posix_spawn_file_actions_addopen(&fa, 0, "/dev/null", O_RDONLY, 0);
+  posix_spawnattr_t attr;
+  posix_spawnattr_init(&attr);
+  posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETPGROUP);
+  posix_spawnattr_setpgroup(&attr, 0);  // a group of its own, led by the engine
   pid_t pid = 0;
-  const int rc = posix_spawnp(&pid, exe.c_str(), &fa, nullptr, argv.data(), environ);
+  const int rc = posix_spawnp(&pid, exe.c_str(), &fa, &attr, argv.data(), environ);
   posix_spawn_file_actions_destroy(&fa);
+  posix_spawnattr_destroy(&attr);
+  if (rc == 0) g_engine_group.store(pid);
+  struct Forget {
+    ~Forget() { g_engine_group.store(0); }
+  } forget;
   if (rc != 0)
     return Error{Status::io_error, "engine: cannot run '" + exe + "' (" + name +
                                        " not installed? --engine-path names it)"};
@@ -207,8 +245,7 @@ Expected<std::string> run_engine(const EngineParams& e, const TriangleMesh& mesh
     if (w == pid) break;
     if (w < 0) return Error{Status::io_error, "engine: lost track of " + name};
     if (ctx.cancelled()) {
-      kill(pid, SIGTERM);
-      waitpid(pid, &status, 0);
+      stop_engine(pid, &status);
       return Error{Status::cancelled, "cancelled"};
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
@@ -227,7 +264,20 @@ Expected<std::string> run_engine(const EngineParams& e, const TriangleMesh& mesh
   std::ifstream in(result, std::ios::binary);
   std::ostringstream text;
   text << in.rdbuf();
-  return text.str();
+  std::string gcode = text.str();
+  if (!ends_complete(gcode))
+    return Error{Status::io_error,
+                 "engine: " + name +
+                     "'s G-code stops before its end (no statistics or config block after the "
+                     "last layer): a truncated file is not printed"};
+  return gcode;
+}
+
+bool kill_running_engine() {
+  const pid_t g = g_engine_group.load();
+  if (g <= 0) return false;
+  ::kill(-g, SIGKILL);
+  return true;
 }
 
 }  // namespace nonplanar

@@ -33,8 +33,14 @@ std::vector<std::string> engine_shell_settings(double first_layer);
 /// Inputs: the engine, the mesh to slice (lowest point on the bed; its XY box centre stays
 /// where it is), the print settings it must agree with (layer heights), what this run asks.
 /// Output: the G-code text the engine wrote. Runs the engine in a temporary folder (removed
-/// afterwards) and stops it on cancellation. Errors: io_error (engine missing, failed: its
-/// last output line), cancelled.
+/// afterwards) in a process group of its own, and stops the group on cancellation (SIGTERM,
+/// SIGKILL after 3 s). Errors: io_error (engine missing, failed: its last output line; a
+/// file without the statistics or config block a slicer writes after the last layer, i.e.
+/// truncated), cancelled.
+/// For a signal handler (async-signal-safe): SIGKILL the running engine's process group, if
+/// one runs; run_engine() then returns and removes its folder. True if there was one.
+bool kill_running_engine();
+
 Expected<std::string> run_engine(const EngineParams& e, const TriangleMesh& mesh,
                                  const PrintConfig& c, const Context& ctx,
                                  const EngineRun& run = {});

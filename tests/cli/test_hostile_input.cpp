@@ -156,6 +156,38 @@ TEST(HostileInput, DuplicateFacetsAndOpenSheets) {
   }
 }
 
+// Hostile-input #13: `check` on files it cannot measure said every figure was 0 and exited
+// 0, which reads as a pass; one coordinate at X = 10 m ran it out of memory.
+TEST(HostileInput, CheckThatMeasuresNothingSaysSo) {
+  const fs::path dir = test::temp_dir("hostile_check");
+  ASSERT_TRUE(write_stl(dir / "b.stl", test::box({0, 0, 0}, {10, 10, 2})));
+  const std::string mesh = " --mesh " + (dir / "b.stl").string();
+  const std::string good =
+      "G90\nM82\nG92 E0\n;LAYER_CHANGE\n;Z:0.2\nG1 X105 Y105 Z0.2 F3000\n"
+      "G1 X115 Y105 E0.5\nG1 X115 Y115 E1.0\n";
+  std::string no_marks = good, lower = good, cr = good;
+  no_marks.replace(no_marks.find(";LAYER_CHANGE"), 13, ";");
+  for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  std::replace(cr.begin(), cr.end(), '\n', '\r');
+  const std::pair<const char*, std::string> files[] = {
+      {"empty", ""}, {"no_marks", no_marks}, {"lower", lower}, {"cr", cr}};
+  for (const auto& [name, text] : files) {
+    const fs::path g = dir / (std::string(name) + ".gcode");
+    test::write_bytes(g, text);
+    const CliRun r = cli("check " + g.string() + mesh);
+    EXPECT_EQ(r.code, 2) << name << ": " << r.out << r.err;
+    EXPECT_EQ(lines(r.err), 1u) << name << ": " << r.err;
+    EXPECT_NE(r.err.find(g.string() + ": "), std::string::npos) << r.err;
+  }
+  test::write_bytes(dir / "good.gcode", good);
+  const CliRun ok = cli("check " + (dir / "good.gcode").string() + mesh);
+  EXPECT_EQ(ok.code, 0) << ok.err;
+  test::write_bytes(dir / "far.gcode", good + "G1 X10000 Y115 E2.0\n");
+  const CliRun far = cli("check " + (dir / "far.gcode").string() + mesh, 60);
+  EXPECT_EQ(far.code, 2) << far.err;
+  EXPECT_NE(far.err.find("line 9: extrusions span"), std::string::npos) << far.err;
+}
+
 TEST(HostileInput, LimitsAreErrorsNamingTheKeyOrSizes) {
   const fs::path dir = test::temp_dir("hostile_limits");
   ASSERT_TRUE(write_stl(dir / "c.stl", test::box({0, 0, 0}, {250, 30, 10})));
@@ -256,6 +288,76 @@ TEST(HostileInput, InterruptLeavesNoFiles) {
     EXPECT_TRUE(left.empty()) << "delay " << delay << ": left " << left.front();
     // Prompt: every stage checks the flag (generous for sanitizer builds on a shared machine).
     EXPECT_LT(waited, 30.0) << "delay " << delay;
+  }
+}
+
+// A stand-in engine: a shell script `body` saved as an executable in `dir`.
+fs::path fake_engine(const fs::path& dir, const std::string& body) {
+  const fs::path f = dir / "engine.sh";
+  test::write_bytes(f, "#!/bin/sh\n" + body);
+  fs::permissions(f, fs::perms::owner_all);
+  return f;
+}
+
+// Hostile-input #4: an engine file cut short (23 of 46 layers, no end G-code, heaters on)
+// was mapped and written. Every libslic3r slicer ends with statistics or its config block.
+TEST(HostileInput, TruncatedEngineOutputIsRefused) {
+  const fs::path dir = test::temp_dir("hostile_engine_cut");
+  ASSERT_TRUE(write_stl(dir / "b.stl", test::box({0, 0, 0}, {10, 10, 1})));
+  const fs::path engine = fake_engine(
+      dir,
+      "out=; prev=\nfor a in \"$@\"; do [ \"$prev\" = --output ] && out=$a; prev=$a; done\n"
+      "printf 'M83\\n;LAYER_CHANGE\\n;Z:0.2\\n;HEIGHT:0.2\\nG1 X100 Y100 Z0.2\\n"
+      "G1 X110 Y100 E0.5\\n' > \"$out\"\n");
+  const std::string out = (dir / "b.gcode").string();
+  const CliRun r = cli("slice -q " + (dir / "b.stl").string() + " -o " + out +
+                       " --planar --engine prusaslicer --engine-path " + engine.string());
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("stops before its end"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out));
+}
+
+// Hostile-input #18: an engine that ignores SIGTERM kept running after Ctrl-C, and a second
+// Ctrl-C left it and its temporary folder behind. Now its process group gets SIGKILL.
+TEST(HostileInput, InterruptStopsAnEngineThatIgnoresSigterm) {
+  const fs::path dir = test::temp_dir("hostile_engine_term");
+  const fs::path tmp = test::temp_dir("hostile_engine_tmp");
+  ASSERT_TRUE(write_stl(dir / "b.stl", test::box({0, 0, 0}, {10, 10, 1})));
+  const fs::path mark = dir / "engine-started";
+  // The marker's name is unique to this run: pgrep finds what is left of the engine by it.
+  const fs::path engine = fake_engine(
+      dir, "trap '' TERM INT\ntouch " + mark.string() + "\nsleep 47.123 &\nwait\nsleep 47.123\n");
+  const std::string out = (dir / "b.gcode").string();
+  for (const int signals : {1, 2}) {
+    fs::remove(mark);
+    const std::string cmd = "export TMPDIR=" + tmp.string() + "; exec " + NONPLANAR_CLI +
+                            " slice -q " + (dir / "b.stl").string() + " -o " + out +
+                            " --planar --engine prusaslicer --engine-path " + engine.string();
+    std::vector<std::string> args = {"/bin/sh", "-c", cmd};
+    std::vector<char*> argv;
+    for (auto& a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    pid_t pid = 0;
+    ASSERT_EQ(posix_spawn(&pid, "/bin/sh", nullptr, nullptr, argv.data(), environ), 0);
+    for (int k = 0; k < 3000 && !fs::exists(mark); ++k)
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    ASSERT_TRUE(fs::exists(mark)) << "the engine never started";
+    const auto t0 = std::chrono::steady_clock::now();
+    for (int k = 0; k < signals; ++k) {
+      ::kill(pid, SIGINT);
+      std::this_thread::sleep_for(std::chrono::milliseconds(200));
+    }
+    int status = 0;
+    ASSERT_EQ(::waitpid(pid, &status, 0), pid);
+    const double waited =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    ASSERT_TRUE(WIFEXITED(status)) << "killed by signal " << WTERMSIG(status);
+    EXPECT_EQ(WEXITSTATUS(status), 130) << signals << " signal(s)";
+    EXPECT_LT(waited, 20.0) << signals << " signal(s)";
+    EXPECT_NE(std::system("pgrep -f 'sleep 4[7].123' >/dev/null"), 0)
+        << signals << " signal(s): the engine is still running";
+    EXPECT_TRUE(listing(tmp).empty()) << signals << " signal(s): left " << listing(tmp).front();
+    EXPECT_FALSE(fs::exists(out));
   }
 }
 

@@ -129,13 +129,20 @@ TEST(MapForeignGcode, RefusesWhatItCannotMapNamingTheLine) {
   ASSERT_TRUE(ok) << ok.error().message;
   EXPECT_EQ(ok->text.rfind("M862.3 P \"MK3S\"\nG29 ; mesh\n", 0), 0u);
   EXPECT_NE(ok->text.find("G1 X1.000 Y1.000 E1.00000"), std::string::npos) << ok->text;
-  // Relative XYZ inside the print is applied here: the mapped moves are absolute (E follows
-  // M82/M83 only, as in the strict reader).
-  auto rel = map_foreign_gcode(head + "G91\nG1 X2 Y1 E1\nG90\nG1 X5 E2\n", *field, {}, {});
+  // Relative XYZ inside the print is applied here: the mapped moves are absolute. G91 makes
+  // E relative too (hostile input #4: read as absolute, it over-extruded 75x on a dome).
+  auto rel = map_foreign_gcode(head + "G91\nG1 X2 Y1 E0.5\nG90\nG1 X5 E2\n", *field, {}, {});
   ASSERT_TRUE(rel) << rel.error().message;
-  EXPECT_NE(rel->text.find("G1 X3.000 Y2.000 E1.00000"), std::string::npos) << rel->text;
+  EXPECT_NE(rel->text.find("G1 X3.000 Y2.000 E1.50000"), std::string::npos) << rel->text;
   EXPECT_NE(rel->text.find("G1 X5.000 Y2.000 E2.00000"), std::string::npos) << rel->text;
   EXPECT_EQ(rel->text.find("\nG91\n"), std::string::npos);
+  // M83 mid-print: the E that follows is relative, in the file and in what is written.
+  auto m83 = map_foreign_gcode(head + "G1 X2 Y1 E2\nM83\nG1 X3 Y1 E0.5\nM82\nG1 X4 Y1 E3\n",
+                               *field, {}, {});
+  ASSERT_TRUE(m83) << m83.error().message;
+  const std::string& t = m83->text;
+  EXPECT_NE(t.find("M83\nG1 X3.000 Y1.000 E0.50000"), std::string::npos) << t;
+  EXPECT_NE(t.find("G1 X4.000 Y1.000 E3.00000"), std::string::npos) << t;
 }
 
 }  // namespace
