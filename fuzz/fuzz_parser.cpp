@@ -38,6 +38,62 @@ struct Waves final : nonplanar::LayerClip {
 }  // namespace
 #endif
 
+#if NONPLANAR_FUZZ_PARSER == 10
+#include <cmath>
+#include <cstdlib>
+
+#include "nonplanar/gcode.hpp"
+#include "nonplanar/slice.hpp"
+#include "nonplanar/toolpaths.hpp"
+namespace {
+// A 10 × 10 × 1 mm box centred at `mid`.
+nonplanar::TriangleMesh settings_box(const nonplanar::Vec2& mid) {
+  nonplanar::TriangleMesh m;
+  for (int k = 0; k < 8; ++k)
+    m.vertices.emplace_back(mid.x() + (k & 1 ? 5 : -5), mid.y() + (k & 2 ? 5 : -5), k & 4 ? 1 : 0);
+  m.faces = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
+             {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
+  return m;
+}
+
+// Traps on a line the printer should never get: over 255 characters, a feed rate outside
+// (0, 60000] mm/min, a fan value outside 0…255, a non-finite number; or a move of the print
+// (from its first extrusion to its last) off the bed.
+void check_settings_output(const std::string& text, const nonplanar::PrintConfig& c) {
+  for (std::size_t p = 0; p < text.size();) {
+    const std::size_t e = std::min(text.find('\n', p), text.size());
+    const std::string line = text.substr(p, e - p);
+    p = e + 1;
+    if (line.size() > 255) __builtin_trap();
+    const bool command = line.rfind("G0 ", 0) == 0 || line.rfind("G1 ", 0) == 0 ||
+                         line.rfind("G92 ", 0) == 0 || line.rfind("M1", 0) == 0;
+    if (command && (line.find("nan") != std::string::npos || line.find("inf") != std::string::npos))
+      __builtin_trap();
+    if (line.rfind("G1 ", 0) == 0 || line.rfind("G0 ", 0) == 0)
+      if (const auto f = line.find(" F"); f != std::string::npos) {
+        const double v = std::strtod(line.c_str() + f + 2, nullptr);
+        if (!(v > 0 && v <= 60000)) __builtin_trap();
+      }
+    if (line.rfind("M106 S", 0) == 0) {
+      const double v = std::strtod(line.c_str() + 6, nullptr);
+      if (!(v >= 0 && v <= 255)) __builtin_trap();
+    }
+  }
+  auto moves = nonplanar::read_gcode_moves(text);
+  if (!moves) __builtin_trap();  // our own G-code must read back
+  std::size_t first = moves->size(), last = 0;
+  for (std::size_t i = 0; i < moves->size(); ++i)
+    if ((*moves)[i].extruding && (*moves)[i].layer >= 0) first = std::min(first, i), last = i;
+  for (std::size_t i = first; i <= last && i < moves->size(); ++i) {
+    const nonplanar::Vec3& q = (*moves)[i].to;
+    if (q.x() < c.bed_min.x() - 1e-3 || q.x() > c.bed_max.x() + 1e-3 ||
+        q.y() < c.bed_min.y() - 1e-3 || q.y() > c.bed_max.y() + 1e-3)
+      __builtin_trap();
+  }
+}
+}  // namespace
+#endif
+
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   using namespace nonplanar;
   const std::string_view in(reinterpret_cast<const char*>(data), size);
@@ -78,8 +134,27 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     (void)head.allowance(d), (void)low.allowance(d), (void)head.block_allowance(d);
   (void)head.allowance_lower_bound(Vec2(-10, -10), Vec2(10, 10));
   (void)t.describe();
+#elif NONPLANAR_FUZZ_PARSER == 10
+  // Settings: any profile that validates must print a small box with every move of the print
+  // on the bed and every number in a line the printer can take (hostile input #21.10: F
+  // -2147483648, M106 S2550, lines cut at 255 characters, a skirt 457 m off the bed).
+  auto c = parse_ini_config(in);
+  if (!c) return 0;
+  const Vec2 mid = c->bed_center();
+  const TriangleMesh box = settings_box(mid);
+  if (c->bed_max.x() - c->bed_min.x() < 12 || c->bed_max.y() - c->bed_min.y() < 12) return 0;
+  auto layers = slice_mesh(box, c->slice, {});
+  if (!layers) return 0;
+  auto paths = make_toolpaths(*layers, c->paths, {});
+  if (!paths) return 0;
+  auto text = make_gcode(*paths, *c, {}, {});
+  if (!text) {
+    if (text.error().status == Status::internal_error) __builtin_trap();
+    return 0;
+  }
+  check_settings_output(*text, *c);
 #else
-#error "NONPLANAR_FUZZ_PARSER must name a parser (0-9)"
+#error "NONPLANAR_FUZZ_PARSER must name a parser (0-10)"
 #endif
   return 0;
 }

@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
 # Run the libFuzzer targets (one per parser; AddressSanitizer + UndefinedBehaviorSanitizer).
 # Usage: fuzz/run.sh [SECONDS=60] [TARGET...]
-#   TARGET: stl obj off 3mf ini json surfaces gcode foreign toolhead (default: all of them,
-#   two at a time; foreign is the mapping of another slicer's G-code, map_foreign_gcode;
-#   toolhead is a head shape file, docs/toolhead.md).
+#   TARGET: stl obj off 3mf ini json surfaces gcode foreign toolhead settings (default: all
+#   of them, two at a time; foreign is the mapping of another slicer's G-code,
+#   map_foreign_gcode; toolhead is a head shape file, docs/toolhead.md; settings prints a box
+#   with any profile that validates and checks the G-code stays on the bed and in range).
 # Builds the missing targets in build-san/ with scripts/sanitize.sh --build-only.
 # Seeds come from ../shared/models, tests/data and toolheads/; corpora grow in build-san/corpus/TARGET,
 # so longer runs pick up where the last one stopped. Findings are written to
@@ -14,7 +15,7 @@ cd "$(dirname "$0")/.."
 secs=${1:-60}
 shift || true
 targets=("$@")
-((${#targets[@]})) || targets=(stl obj off 3mf ini json surfaces gcode foreign toolhead)
+((${#targets[@]})) || targets=(stl obj off 3mf ini json surfaces gcode foreign toolhead settings)
 out=${BUILD_DIR:-build-san}
 missing=0
 for t in "${targets[@]}"; do [[ -x "$out/fuzz/fuzz_$t" ]] || missing=1; done
@@ -35,9 +36,12 @@ seed stl "$models"/*.stl
 seed obj "$models"/*.obj
 seed off "$models"/*.off
 seed ini tests/data/*.ini
+seed settings tests/data/*.ini
 seed toolhead toolheads/*.json
 mkdir -p "$out/corpus/json" "$out/corpus/surfaces" "$out/corpus/gcode" "$out/corpus/3mf" \
-  "$out/corpus/foreign"
+  "$out/corpus/foreign" "$out/corpus/settings"
+printf 'skirts = 3\nskirt_distance = 30\nbed_shape = 0x0,80x0,80x80,0x80\ntravel_speed = 900\nmax_fan_speed = 100\nextrusion_multiplier = 4.9\nfirst_layer_extrusion_width = 200%%\nlayer_height = 0.05\n' \
+  >"$out/corpus/settings/seed.ini"
 printf '{"layer_height": 0.2, "fill_density": "20%%", "bed_shape": "0x0,220x0,220x220,0x220"}' \
   >"$out/corpus/json/profile.json"
 printf '%s' '{"format":"nonplanar-surfaces","version":1,"surfaces":[{"patch":0,"degree_u":2,'\

@@ -1,9 +1,12 @@
 #include "cli_common.hpp"
 
+#include <sys/resource.h>
+#include <sys/time.h>
 #include <unistd.h>
 
 #include <atomic>
 #include <cerrno>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <cstring>
@@ -16,6 +19,14 @@ namespace nonplanar::cli {
 namespace {
 bool g_progress_drawn = false;
 std::atomic<bool> g_interrupted{false};
+std::atomic<bool> g_timed_out{false};
+double g_max_time = 0, g_max_memory = 0;
+
+// --max-time: the same cancellation as Ctrl-C, reported as the limit.
+extern "C" void on_alarm(int) {
+  g_timed_out = true;
+  g_interrupted = true;
+}
 
 // First Ctrl-C (or SIGTERM): ask the stages to stop; they return Status::cancelled and the
 // atomic writer removes its temporary. A second one: kill a running engine, or else remove the
@@ -40,6 +51,54 @@ void install_interrupt_handler() {
   sigemptyset(&sa.sa_mask);
   sigaction(SIGINT, &sa, nullptr);
   sigaction(SIGTERM, &sa, nullptr);
+}
+
+void add_limit_options(CLI::App& app, Limits& l) {
+  app.add_option("--max-memory", l.max_memory_mb,
+                 "Stop with exit 2 when the run needs more than this much memory (MB;\n"
+                 "0: no limit). Address space, so allow room beyond the model's size")
+      ->check(CLI::Range(0.0, 1e9));
+  app.add_option("--max-time", l.max_time_s,
+                 "Stop with exit 2 after this many seconds (0: no limit), as Ctrl-C stops")
+      ->check(CLI::Range(0.0, 1e7));
+}
+
+bool install_limits(const Limits& l) {
+  g_max_memory = l.max_memory_mb, g_max_time = l.max_time_s;
+  if (l.max_memory_mb > 0) {
+#if defined(__SANITIZE_ADDRESS__)
+    std::fprintf(stderr, "warning: --max-memory is not enforced in an AddressSanitizer build\n");
+#else
+    const auto bytes = static_cast<rlim_t>(l.max_memory_mb * 1048576.0);
+    const struct rlimit r { bytes, bytes };
+    if (::setrlimit(RLIMIT_AS, &r) != 0) {
+      std::fprintf(stderr, "error: --max-memory: %s\n", std::strerror(errno));
+      return false;
+    }
+#endif
+  }
+  if (l.max_time_s > 0) {
+    struct sigaction sa {};
+    sa.sa_handler = on_alarm;
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGALRM, &sa, nullptr);
+    struct itimerval t {};
+    t.it_value.tv_sec = static_cast<time_t>(l.max_time_s);
+    t.it_value.tv_usec = static_cast<suseconds_t>((l.max_time_s - std::floor(l.max_time_s)) * 1e6);
+    setitimer(ITIMER_REAL, &t, nullptr);
+  }
+  return true;
+}
+
+int report_out_of_memory() {
+  remove_pending_temporary_file();  // the writer may have been what ran out
+  if (g_max_memory > 0) {
+    std::fprintf(stderr, "error: the run needs more than --max-memory %g MB; nothing was written\n",
+                 g_max_memory);
+    return kExitBadInput;
+  }
+  std::fprintf(stderr, "error: out of memory\n");
+  return kExitFailure;
 }
 
 void MeshOptions::add_to(CLI::App& cmd) {
@@ -154,6 +213,10 @@ bool flush_stdout() {
 }
 
 int report_error(const Error& e) {
+  if (e.status == Status::cancelled && g_timed_out) {
+    std::fprintf(stderr, "error: stopped after --max-time %g s; nothing was written\n", g_max_time);
+    return kExitBadInput;
+  }
   if (e.status == Status::cancelled) {
     std::fprintf(stderr, "error: interrupted; nothing was written\n");
     return kExitInterrupted;

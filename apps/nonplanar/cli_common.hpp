@@ -26,6 +26,18 @@ constexpr int kExitInterrupted = 130;  ///< 128 + SIGINT, as shells report it
 /// at once after removing any half-written temporary file. Call once from main.
 void install_interrupt_handler();
 
+/// Resource limits for one run (README, "Faults"): 0 means none.
+struct Limits {
+  double max_memory_mb = 0;  ///< address space, enforced with RLIMIT_AS
+  double max_time_s = 0;     ///< wall time; then the run stops as on Ctrl-C, with exit 2
+};
+/// --max-memory and --max-time on the top-level app (they work after the command too).
+void add_limit_options(CLI::App& app, Limits& l);
+/// Applies the limits; false (after an error line) if the system refused.
+bool install_limits(const Limits& l);
+/// The message and exit code for std::bad_alloc: exit 2 under --max-memory, else 1.
+int report_out_of_memory();
+
 /// Options for reading and placing the model, added to a subcommand.
 struct MeshOptions {
   std::string model;

@@ -15,6 +15,9 @@ int main(int argc, char** argv) {
       "Run 'nonplanar COMMAND --help' for the options of a command."};
   app.set_version_flag("--version", "nonplanar 0.1.0");
   app.require_subcommand(1);
+  app.fallthrough();  // the limits below may follow the command's own options
+  Limits limits;
+  add_limit_options(app, limits);
   std::function<int()> run;
   register_analyze(app, &run);
   register_fit(app, &run);
@@ -28,13 +31,15 @@ int main(int argc, char** argv) {
     return rc == 0 ? kExitOk : kExitBadInput;
   }
   install_interrupt_handler();
+  if (!install_limits(limits)) return kExitBadInput;
   try {
     const int rc = run ? run() : kExitBadInput;
     // Figures that never reached their reader are not a success (`check --json > /dev/full`).
     if (!flush_stdout()) return rc == kExitOk ? kExitBadInput : rc;
     return rc;
   } catch (const std::bad_alloc&) {
-    std::fprintf(stderr, "error: out of memory\n");
+    finish_progress();
+    return report_out_of_memory();
   } catch (const std::exception& e) {
     std::fprintf(stderr, "error: internal: %s\n", e.what());
   }

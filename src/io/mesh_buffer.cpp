@@ -28,7 +28,9 @@ FileBytes::~FileBytes() {
 }
 
 Expected<FileBytes> read_file_bytes(const std::filesystem::path& file, std::size_t max_bytes) {
-  const int fd = ::open(file.c_str(), O_RDONLY | O_CLOEXEC);
+  // O_NONBLOCK: opening a FIFO otherwise waits for a writer, forever (hostile input #21.20);
+  // it changes nothing for a regular file, and anything else is refused below.
+  const int fd = ::open(file.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
   if (fd < 0)
     return Error{Status::io_error, errno == ENOENT
                                        ? std::string("file not found")
@@ -37,7 +39,9 @@ Expected<FileBytes> read_file_bytes(const std::filesystem::path& file, std::size
   if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
     ::close(fd);
     return Error{Status::io_error,
-                 S_ISDIR(st.st_mode) ? "is a folder, not a file" : "not a regular file"};
+                 S_ISDIR(st.st_mode)
+                     ? "is a folder, not a file"
+                     : "not a regular file (a pipe or a device cannot be read as a model)"};
   }
   const auto size = static_cast<std::size_t>(st.st_size);
   if (size > max_bytes) {

@@ -3,6 +3,7 @@
 // `check` accepts; never a signal, a hang or a file left behind. Ctrl-C leaves nothing.
 #include <fcntl.h>
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <signal.h>
 #include <spawn.h>
@@ -113,6 +114,11 @@ TEST(HostileInput, BrokenFilesEndCleanly) {
   expect_clean_outcome(dir / "notes.3mf", "zip that is not a 3MF");
   test::write_bytes(dir / "one.obj", "v 0 0 0\nv 10 0 0\nv 0 10 0\nf 1 2 3\n");
   expect_clean_outcome(dir / "one.obj", "single triangle");
+  // A FIFO as input waited for a writer forever.
+  ASSERT_EQ(::mkfifo((dir / "fifo.stl").c_str(), 0644), 0);
+  const CliRun fifo = cli("analyze " + (dir / "fifo.stl").string(), 20);
+  EXPECT_EQ(fifo.code, 2) << fifo.err;
+  EXPECT_NE(fifo.err.find("not a regular file"), std::string::npos) << fifo.err;
   test::write_bytes(dir / "empty.stl", "");
   expect_clean_outcome(dir / "empty.stl", "empty file");
   // A part below one extrusion: an error that says why, not G-code with only a skirt.
@@ -359,6 +365,28 @@ TEST(HostileInput, InterruptStopsAnEngineThatIgnoresSigterm) {
     EXPECT_TRUE(listing(tmp).empty()) << signals << " signal(s): left " << listing(tmp).front();
     EXPECT_FALSE(fs::exists(out));
   }
+}
+
+// The documented resource limits: the run stops with exit 2, says which limit, and writes
+// nothing.
+TEST(HostileInput, MemoryAndTimeLimitsStopTheRun) {
+  const fs::path models = test::shared_models();
+  if (models.empty()) GTEST_SKIP() << "../shared/models not present";
+  const std::string model = (models / "np_stanford_bunny_closed_compas.stl").string();
+  const fs::path dir = test::temp_dir("hostile_limits_run");
+  const std::string out = (dir / "bunny.gcode").string();
+  const CliRun slow = cli("slice -q " + model + " -o " + out + " --max-time 0.5");
+  EXPECT_EQ(slow.code, 2) << slow.err;
+  EXPECT_NE(slow.err.find("stopped after --max-time 0.5 s"), std::string::npos) << slow.err;
+  EXPECT_TRUE(listing(dir).empty());
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "AddressSanitizer reserves terabytes of address space: no RLIMIT_AS";
+#else
+  const CliRun big = cli("slice -q " + model + " -o " + out + " --max-memory 150");
+  EXPECT_EQ(big.code, 2) << big.err;
+  EXPECT_NE(big.err.find("needs more than --max-memory 150 MB"), std::string::npos) << big.err;
+  EXPECT_TRUE(listing(dir).empty());
+#endif
 }
 
 }  // namespace
