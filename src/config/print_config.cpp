@@ -133,6 +133,17 @@ Expected<bool> set_value(PrintConfig& c, const std::string& key, const std::stri
     else if (v == "grid")
       t.fill_pattern = InfillPattern::grid;
     else {
+      // PrusaSlicer's and OrcaSlicer's other patterns: printed as grid, with a note. Any
+      // other word is a typo, and an error.
+      static const char* const known[] = {
+          "triangles",     "stars",        "cubic",        "concentric",        "honeycomb",
+          "3dhoneycomb",   "gyroid",       "hilbertcurve", "archimedeanchords", "octagramspiral",
+          "adaptivecubic", "supportcubic", "lightning",    "monotoniclines",    "crosshatch",
+          "zig-zag",       "tri-hexagon",  "quartercubic"};
+      if (std::find(std::begin(known), std::end(known), v) == std::end(known))
+        return bad(key, "'" + v +
+                            "' is not a fill pattern (rectilinear, grid, or one of "
+                            "PrusaSlicer's, printed as grid)");
       t.fill_pattern = InfillPattern::grid;
       c.notes.push_back("fill_pattern " + v + " is not supported; using grid");
     }

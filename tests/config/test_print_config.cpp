@@ -120,6 +120,17 @@ TEST(Config, EverySettingHasARange) {
   }
 }
 
+TEST(Config, UnknownFillPatternIsAnErrorAndPrusaSlicersAreNoted) {
+  PrintConfig c;
+  auto typo = set_config_value(c, "fill_pattern", "nosuchpattern");
+  ASSERT_FALSE(typo);
+  EXPECT_NE(typo.error().message.find("fill_pattern: 'nosuchpattern'"), std::string::npos);
+  ASSERT_TRUE(set_config_value(c, "fill_pattern", "gyroid"));
+  EXPECT_EQ(c.paths.fill_pattern, InfillPattern::grid);
+  ASSERT_EQ(c.notes.size(), 1u);
+  EXPECT_NE(c.notes[0].find("gyroid"), std::string::npos);
+}
+
 TEST(Config, DefaultPurgeLineFitsTheBed) {
   EXPECT_EQ(default_start_gcode({0, 0}, {220, 220}), GcodeParams().start_gcode);
   auto c = parse_ini_config("bed_shape = 0x0,180x0,180x180,0x180\n");
