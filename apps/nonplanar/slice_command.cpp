@@ -53,15 +53,32 @@ int run(const SliceOptions& o) {
   for (const auto& [key, value] : o.named)
     if (!value->empty()) overrides.push_back(key + "=" + *value);
   overrides.insert(overrides.end(), o.sets.begin(), o.sets.end());
+  std::vector<std::string> engine_only;
   for (const std::string& kv : overrides) {
     auto applied = apply_setting(cfg, kv);
+    const auto eq = kv.find('=');
+    // A key only the engine knows (brim_width, support_material, ...) goes to it alone.
+    if (!applied && engine.engine != Engine::builtin && eq != std::string::npos) {
+      const std::string key = kv.substr(0, eq), value = kv.substr(eq + 1);
+      if (auto known = set_config_value(cfg, key, value); known && !*known) {
+        engine.overrides.emplace_back(key, value);
+        engine_only.push_back(key);
+        continue;
+      }
+    }
     if (!applied) return report_error(applied.error());
     if (!is_nonplanar_key(applied->first)) engine.overrides.push_back(std::move(*applied));
   }
   if (auto v = validate_config(cfg); !v) return report_error(v.error());
   if (auto a = check_max_angle(o.max_angle); !a) return report_error(a.error());
-  if (!o.mesh.quiet)
+  if (!o.mesh.quiet) {
     for (const auto& n : cfg.notes) std::fprintf(stderr, "warning: %s\n", n.c_str());
+    for (const auto& k : engine_only)
+      std::fprintf(stderr,
+                   "notice: %s is passed to %s only (the built-in engine has no such "
+                   "setting)\n",
+                   k.c_str(), o.engine.c_str());
+  }
 
   Context ctx = make_context(o.mesh.quiet);
   LoadParams lp = o.mesh.load;

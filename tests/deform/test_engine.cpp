@@ -153,6 +153,24 @@ TEST(EnginePrusaSlicer, ACoreOffThePlannedBoundariesFallsBackToPlanar) {
   EXPECT_TRUE(said);
 }
 
+// A key only PrusaSlicer knows goes to it, said so, instead of "unknown setting" (#16).
+TEST(EnginePrusaSlicer, EngineOnlyKeysReachTheEngine) {
+  if (!have_prusaslicer()) GTEST_SKIP() << "prusa-slicer not installed";
+  const auto dir = test::temp_dir("engine_keys");
+  ASSERT_TRUE(write_stl(dir / "b.stl", test::box({0, 0, 0}, {10, 10, 2})));
+  const auto out = dir / "b.gcode";
+  auto r = test::run_cli("slice " + (dir / "b.stl").string() + " --planar --engine prusaslicer " +
+                         "--set brim_width=5 -o " + out.string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("notice: brim_width is passed to prusaslicer only"), std::string::npos)
+      << r.err;
+  EXPECT_NE(test::read_bytes(out).find("; brim_width = 5\n"), std::string::npos);
+  r = test::run_cli("slice -q " + (dir / "b.stl").string() + " --set brim_width=5 -o " +
+                    out.string() + "2");
+  EXPECT_EQ(r.code, 2);  // the built-in engine has no brim: still refused, not ignored
+  EXPECT_NE(r.err.find("unknown setting 'brim_width'"), std::string::npos) << r.err;
+}
+
 TEST(EngineOption, BadEngineOrMissingExecutableIsAOneLineError) {
   const auto dir = test::temp_dir("engine_bad");
   const auto stl = dir / "saddle.stl";
