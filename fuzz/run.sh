@@ -52,6 +52,8 @@ printf 'G90\nM83\nG92 E0\n;LAYER_CHANGE\n;Z:0.2\n;TYPE:Perimeter\nG1 X1 Y2 Z0.2 
   >"$out/corpus/gcode/moves.gcode"
 printf 'M82\nG28\n;LAYER_CHANGE\n;Z:0.2\n;HEIGHT:0.2\nG1 Z.2 F7800\nG1 X10 Y10 F7800\n;TYPE:Perimeter\n;WIDTH:0.45\nG1 X30 Y10 E1.2 F1800\n;WIPE_START\nG1 X25 Y10 E-0.4\n;WIPE_END\nG1 E-0.8 F2400\nG92 E0\n;LAYER_CHANGE\n;Z:0.4\n;HEIGHT:0.2\nG1 Z.4\nG1 X40 Y40 F7800\nG1 E0.8\nG1 X45 Y40 E0.3\nM107\n;TYPE:Custom\nG28 X0\n' \
   >"$out/corpus/foreign/two_layers.gcode"
+printf 'M83\n;LAYER_CHANGE\n;Z:0.2\n;HEIGHT:0.2\nG1 X10 Y10 Z0.2 F7800\nG1 X20 Y10 E0.5\nG91\nG1 E-0.8\nG1 Z0.4 X2\nG90\nM82\nG92 E0\nG1 X30 Y12 E0.7\nM83\nG1 X32 Y12 E0.1\n; filament used [mm] = 1.0\n' \
+  >"$out/corpus/foreign/e_modes.gcode"
 # A minimal 3MF package (one tetrahedron), zipped here so no binary lives in the repository.
 tmf=$(mktemp -d)
 mkdir -p "$tmf/_rels" "$tmf/3D"
