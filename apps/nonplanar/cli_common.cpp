@@ -15,6 +15,16 @@
 #include "core/atomic_file.hpp"
 #include "slice/external_engine.hpp"
 
+// AddressSanitizer reserves terabytes of address space: RLIMIT_AS cannot work under it.
+// (GCC defines __SANITIZE_ADDRESS__; clang answers __has_feature.)
+#if defined(__SANITIZE_ADDRESS__)
+#define NONPLANAR_ASAN 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define NONPLANAR_ASAN 1
+#endif
+#endif
+
 namespace nonplanar::cli {
 namespace {
 bool g_progress_drawn = false;
@@ -66,7 +76,7 @@ void add_limit_options(CLI::App& app, Limits& l) {
 bool install_limits(const Limits& l) {
   g_max_memory = l.max_memory_mb, g_max_time = l.max_time_s;
   if (l.max_memory_mb > 0) {
-#if defined(__SANITIZE_ADDRESS__)
+#if defined(NONPLANAR_ASAN)
     std::fprintf(stderr, "warning: --max-memory is not enforced in an AddressSanitizer build\n");
 #else
     const auto bytes = static_cast<rlim_t>(l.max_memory_mb * 1048576.0);

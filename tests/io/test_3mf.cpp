@@ -124,9 +124,11 @@ TEST(ThreeMfErrors, ComponentBombIsCountedNotBuilt) {
   NMR::PLib3MFModel* model = nullptr;
   ASSERT_EQ(NMR::lib3mf_createmodel(&model), 0);
   NMR::PLib3MFModelObjectResource* level = add_cube(model);
+  std::vector<NMR::PLib3MFBase*> owned{level};
   for (int depth = 0; depth < 7; ++depth) {
     NMR::PLib3MFModelComponentsObject* up = nullptr;
     ASSERT_EQ(NMR::lib3mf_model_addcomponentsobject(model, &up), 0);
+    owned.push_back(up);
     for (int i = 0; i < 10; ++i) {
       NMR::MODELTRANSFORM m = identity();
       m.m_fFields[0][3] = static_cast<float>(i);
@@ -140,6 +142,7 @@ TEST(ThreeMfErrors, ComponentBombIsCountedNotBuilt) {
   ASSERT_EQ(NMR::lib3mf_model_addbuilditem(model, level, nullptr, &item), 0);
   const std::string bytes = write_model(model, dir / "bomb.3mf");
   NMR::lib3mf_release(item);
+  for (auto* o : owned) NMR::lib3mf_release(o);
   NMR::lib3mf_release(model);
   EXPECT_LT(bytes.size(), 20000u);
   auto r = io::parse_3mf(bytes);
