@@ -123,7 +123,10 @@ void MeshOptions::add_to(CLI::App& cmd) {
 }
 
 void ProfileOptions::add_to(CLI::App& cmd, const std::string& what) {
-  cmd.add_option("--config", config, "Profile: .json or PrusaSlicer .ini (" + what + ")");
+  cmd.add_option("--config", config,
+                 "Profile: .json or PrusaSlicer .ini (" + what +
+                     "); repeat it for a printer, a print and a filament file, each over the "
+                     "ones before");
   cmd.add_option("--set", sets,
                  "Any setting by its key, after the profile: --set KEY=VALUE (e.g.\n"
                  "nozzle_cone_angle=40, toolhead_shape=prusa-mk3s; docs/toolhead.md)");
@@ -148,8 +151,8 @@ void ProfileOptions::add_keyed(CLI::App& cmd, const std::string& name, const std
 
 Expected<PrintConfig> ProfileOptions::load() const {
   PrintConfig cfg;
-  if (!config.empty()) {
-    auto c = load_config(config);
+  for (const std::string& file : config) {
+    auto c = load_config(file, std::move(cfg));
     if (!c) return c.error();
     cfg = std::move(*c);
   }

@@ -49,7 +49,7 @@ struct MeshOptions {
 /// The print profile a subcommand reads: --config FILE, then --set KEY=VALUE in order (any
 /// PrusaSlicer key we read, and ours: the toolhead's keys, docs/toolhead.md).
 struct ProfileOptions {
-  std::string config;
+  std::vector<std::string> config;  ///< profiles, each over the ones before it
   std::vector<std::string> sets;
   /// A subcommand's own options that are profile keys (--block-radius is
   /// heater_block_radius): key and the value given, applied before `sets`. A list, so the

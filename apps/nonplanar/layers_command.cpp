@@ -46,9 +46,9 @@ Expected<SliceJob> layers_job(const LayersOptions& o) {
 }
 
 int run(const LayersOptions& o) {
-  if (auto c = check_outputs({o.mesh.model, o.profile.config},
-                             {o.export_layers, o.export_normalized, o.section});
-      !c)
+  std::vector<std::string> inputs = o.profile.config;
+  inputs.push_back(o.mesh.model);
+  if (auto c = check_outputs(inputs, {o.export_layers, o.export_normalized, o.section}); !c)
     return report_error(c.error());
   auto job = layers_job(o);
   if (!job) return report_error(job.error());

@@ -13,7 +13,8 @@ namespace {
 
 struct SliceOptions {
   MeshOptions mesh;
-  std::string output, config;
+  std::string output;
+  std::vector<std::string> config;  ///< profiles, each over the ones before
   std::string engine = "builtin", engine_path, engine_config, engine_filaments;
   bool planar = false;
   double max_angle = 30.0;
@@ -24,10 +25,9 @@ struct SliceOptions {
 };
 
 int run(const SliceOptions& o) {
-  if (auto c = check_outputs(
-          {o.mesh.model, o.config, o.engine_config, o.engine_filaments, o.engine_path}, {o.output});
-      !c)
-    return report_error(c.error());
+  std::vector<std::string> inputs = o.config;
+  inputs.insert(inputs.end(), {o.mesh.model, o.engine_config, o.engine_filaments, o.engine_path});
+  if (auto c = check_outputs(inputs, {o.output}); !c) return report_error(c.error());
   PrintConfig cfg;
   EngineParams engine;
   if (o.engine == "prusaslicer")
@@ -39,12 +39,13 @@ int run(const SliceOptions& o) {
                          "--engine: '" + o.engine + "' is not builtin, prusaslicer or orcaslicer"});
   engine.path = o.engine_path, engine.config = o.engine_config,
   engine.filaments = o.engine_filaments;
-  // PrusaSlicer's profile is ours too (layer heights, bed, filament), unless --config names one.
-  const std::string profile = !o.config.empty()                      ? o.config
-                              : engine.engine == Engine::prusaslicer ? o.engine_config
-                                                                     : "";
-  if (!profile.empty()) {
-    auto c = load_config(profile);
+  // PrusaSlicer's profile is ours too (layer heights, bed, filament), unless --config names
+  // one. Several --config files load in order, each over the ones before.
+  std::vector<std::string> profiles = o.config;
+  if (profiles.empty() && engine.engine == Engine::prusaslicer && !o.engine_config.empty())
+    profiles.push_back(o.engine_config);
+  for (const std::string& profile : profiles) {
+    auto c = load_config(profile, std::move(cfg));
     if (!c) return report_error(c.error());
     cfg = std::move(*c);
   }
@@ -139,7 +140,9 @@ void register_slice(CLI::App& app, std::function<int()>* run_fn) {
       "the options below (or --set KEY=VALUE with any PrusaSlicer key) override it.");
   o->mesh.add_to(*cmd);
   cmd->add_option("-o,--output", o->output, "G-code file to write (atomically)")->required();
-  cmd->add_option("--config", o->config, "Profile: .json or PrusaSlicer .ini");
+  cmd->add_option("--config", o->config,
+                  "Profile: .json or PrusaSlicer .ini; repeat it for a printer, a print and a\n"
+                  "filament file (PrusaSlicer exports them one by one), each over the ones before");
   cmd->add_flag("--planar", o->planar, "Planar layers only (the ordinary slicing engine)");
   cmd->add_option("--engine", o->engine,
                   "Planar engine for the normalised mesh: builtin, prusaslicer (PrusaSlicer 2.5+\n"

@@ -120,8 +120,10 @@ bool is_nonplanar_key(const std::string& key);
 Expected<bool> validate_config(const PrintConfig& c);
 
 /// Loads a JSON profile ({"layer_height": 0.2, ...}, keys as above) or a PrusaSlicer .ini
-/// (key = value lines) over the defaults. Error: "FILE: line N: problem".
-Expected<PrintConfig> load_config(const std::filesystem::path& file);
+/// (key = value lines) over `base` (the defaults, or the profiles loaded before it: a
+/// printer, a print and a filament file, as PrusaSlicer exports them one by one).
+/// Error: "FILE: line N: problem".
+Expected<PrintConfig> load_config(const std::filesystem::path& file, PrintConfig base = {});
 
 /// Parses .ini text / JSON text over `base` (for tests and fuzzing).
 Expected<PrintConfig> parse_ini_config(std::string_view text, PrintConfig base = {});

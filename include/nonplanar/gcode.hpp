@@ -42,7 +42,8 @@ double filament_per_mm(double width, double height, const GcodeParams& g);
 
 /// Are the profile's start and end G-code safe for make_gcode? Refused: a placeholder or
 /// macro it cannot fill in ("{max_layer_z}", "[printer_model]", "{if …}"), outside comments;
-/// a move off the bed. Error: invalid_argument naming the key, the line and the bed.
+/// a move off the bed; a line over 255 characters, or with a control byte, or a non-ASCII
+/// byte outside its comment. Error: invalid_argument naming the key, the line and the bed.
 Expected<bool> check_custom_gcode(const PrintConfig& c);
 
 /// The whole program as text. Refuses (invalid_argument) a program that would leave the bed

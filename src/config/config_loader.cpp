@@ -31,16 +31,16 @@ Expected<PrintConfig> parse_json_config(std::string_view text, PrintConfig c) {
   return c;
 }
 
-Expected<PrintConfig> load_config(const std::filesystem::path& file) {
+Expected<PrintConfig> load_config(const std::filesystem::path& file, PrintConfig base) {
   auto bytes = io::read_file_bytes(file, 64u << 20);
   if (!bytes) return Error{bytes.error().status, file.string() + ": " + bytes.error().message};
   std::string ext = file.extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(),
                  [](unsigned char ch) { return std::tolower(ch); });
   Expected<PrintConfig> r =
-      ext == ".json" ? parse_json_config(bytes->view())
+      ext == ".json" ? parse_json_config(bytes->view(), std::move(base))
       : ext == ".ini"
-          ? parse_ini_config(bytes->view())
+          ? parse_ini_config(bytes->view(), std::move(base))
           : Expected<PrintConfig>(Error{Status::unsupported, "use a .json or .ini profile"});
   if (!r) return Error{r.error().status, file.string() + ": " + r.error().message};
   return r;

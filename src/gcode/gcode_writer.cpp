@@ -102,6 +102,26 @@ std::string leftover_placeholder(std::string_view block) {
   return {};
 }
 
+// The first line of `block` a firmware cannot take as written: longer than 255 characters
+// (Marlin reads 96), or with a control byte anywhere or a non-ASCII byte outside the
+// comment (the settings fuzzer sent binary through end_gcode). "" when all are fine.
+std::string unprintable_line(std::string_view block) {
+  int n = 0;
+  for (std::size_t p = 0; p < block.size();) {
+    const std::size_t e = std::min(block.find('\n', p), block.size());
+    const std::string_view l = block.substr(p, e - p);
+    p = e + 1, ++n;
+    if (l.size() > 255) return "line " + std::to_string(n) + " is longer than 255 characters";
+    const std::size_t semi = std::min(l.find(';'), l.size());
+    for (std::size_t i = 0; i < l.size(); ++i) {
+      const auto b = static_cast<unsigned char>(l[i]);
+      if ((b < 0x20 && b != '\t' && b != '\r') || b == 0x7f || (b >= 0x80 && i < semi))
+        return "line " + std::to_string(n) + " holds a byte that is not printable ASCII";
+    }
+  }
+  return {};
+}
+
 bool on_bed(const Vec3& p, const PrintConfig& c) {
   constexpr double eps = 1e-3;  // what %.3f may round
   return p.x() >= c.bed_min.x() - eps && p.x() <= c.bed_max.x() + eps &&
@@ -318,6 +338,8 @@ Expected<std::string> make_gcode(const std::vector<LayerToolpaths>& layers, cons
 Expected<bool> check_custom_gcode(const PrintConfig& c) {
   const std::string start = expand(c.gcode.start_gcode, c), end = expand(c.gcode.end_gcode, c);
   for (const auto& [key, block] : {std::pair{"start_gcode", &start}, {"end_gcode", &end}}) {
+    if (const std::string bad = unprintable_line(*block); !bad.empty())
+      return Error{Status::invalid_argument, std::string(key) + ": " + bad};
     const std::string left = leftover_placeholder(*block);
     if (!left.empty())
       return Error{Status::invalid_argument,

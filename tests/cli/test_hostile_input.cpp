@@ -399,5 +399,31 @@ TEST(HostileInput, MemoryAndTimeLimitsStopTheRun) {
 #endif
 }
 
+// PrusaSlicer exports the printer, the print and the filament as three files; only one
+// --config was taken (#16). Each now loads over the ones before, and relative widths resolve
+// against the nozzle of the printer file.
+TEST(HostileInput, SeveralProfilesLoadInOrder) {
+  const fs::path dir = test::temp_dir("profiles_three");
+  ASSERT_TRUE(write_stl(dir / "b.stl", test::box({0, 0, 0}, {10, 10, 2})));
+  test::write_bytes(dir / "printer.ini",
+                    "nozzle_diameter = 0.6\nbed_shape = 0x0,250x0,250x210,0x210\n"
+                    "temperature = 200\n");
+  test::write_bytes(dir / "print.ini", "layer_height = 0.3\nfirst_layer_height = 0.3\n");
+  test::write_bytes(dir / "filament.ini", "temperature = 240\nfirst_layer_temperature = 245\n");
+  const std::string out = (dir / "b.gcode").string();
+  const CliRun r =
+      cli("slice -q --planar " + (dir / "b.stl").string() + " -o " + out + " --config " +
+          (dir / "printer.ini").string() + " --config " + (dir / "print.ini").string() +
+          " --config " + (dir / "filament.ini").string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string g = test::read_bytes(out);
+  EXPECT_NE(g.find("\nM109 S245\n"), std::string::npos);
+  EXPECT_NE(g.find("\nM104 S240\n"), std::string::npos);  // the filament's, not the printer's
+  EXPECT_NE(g.find(";HEIGHT:0.300"), std::string::npos);
+  EXPECT_NE(g.find(";WIDTH:0.675"), std::string::npos);    // auto: 1.125 x the 0.6 nozzle
+  EXPECT_NE(g.find("G1 X2 Y20 Z0.3"), std::string::npos);  // the purge of the 250 x 210 bed
+  EXPECT_NE(g.find("G1 Y190 E"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace nonplanar

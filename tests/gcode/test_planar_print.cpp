@@ -217,6 +217,18 @@ TEST(PlanarPrint, CustomGcodeIsCheckedNotPassedRaw) {
   PrintConfig end;
   end.gcode.end_gcode = "G1 X0 Y200 Z{max_layer_z}\n";
   EXPECT_FALSE(check_custom_gcode(end));
+  // Found by the settings fuzzer: binary bytes in end_gcode went to the printer raw.
+  end.gcode.end_gcode = "M104 S0\nM84 \xb7\xb7\n";
+  auto binary = check_custom_gcode(end);
+  ASSERT_FALSE(binary);
+  EXPECT_EQ(binary.error().message, "end_gcode: line 2 holds a byte that is not printable ASCII");
+  end.gcode.end_gcode =
+      "M104 S0 ; 215 \xc2\xb0"
+      "C\n" +
+      std::string(300, ';') + "\n";
+  auto long_line = check_custom_gcode(end);
+  ASSERT_FALSE(long_line);
+  EXPECT_EQ(long_line.error().message, "end_gcode: line 2 is longer than 255 characters");
   // The default purge on a 180 mm bed, given as text the way an old profile carries it.
   PrintConfig small = start_of(PrintConfig{}.gcode.start_gcode);
   small.bed_max = Vec2(180, 180);
