@@ -32,26 +32,40 @@ std::atomic<bool> g_interrupted{false};
 std::atomic<bool> g_timed_out{false};
 double g_max_time = 0, g_max_memory = 0;
 
-// --max-time: the same cancellation as Ctrl-C, reported as the limit.
-extern "C" void on_alarm(int) {
-  g_timed_out = true;
-  g_interrupted = true;
+constexpr unsigned kGraceSeconds = 10;  // after a stop request, before leaving regardless
+
+// Leaving now: the temporary output goes; a running engine is killed instead, and its run
+// (which returns at once) removes its folder and reports. Async-signal-safe calls only.
+void leave_now(int code, const char* msg, std::size_t len) {
+  if (kill_running_engine()) return;
+  remove_pending_temporary_file();
+  (void)!::write(STDERR_FILENO, msg, len);
+  ::_exit(code);
 }
 
 // First Ctrl-C (or SIGTERM): ask the stages to stop; they return Status::cancelled and the
-// atomic writer removes its temporary. A second one: kill a running engine, or else remove the
-// temporary and leave now.
-// Only async-signal-safe calls here (unlink, write, _exit).
+// atomic writer removes its temporary. Code that cannot be cancelled (lib3mf reading a
+// file of nested components took 37 s) gets kGraceSeconds, then SIGALRM leaves anyway. A
+// second Ctrl-C leaves at once.
 extern "C" void on_interrupt(int) {
   if (g_interrupted.exchange(true)) {
-    // An engine running: kill it; its run returns at once, removes its folder and reports
-    // the interruption (leaving now would orphan both).
-    if (kill_running_engine()) return;
-    remove_pending_temporary_file();
     constexpr char msg[] = "\nerror: interrupted\n";
-    (void)!::write(STDERR_FILENO, msg, sizeof msg - 1);
-    ::_exit(kExitInterrupted);
+    return leave_now(kExitInterrupted, msg, sizeof msg - 1);
   }
+  ::alarm(kGraceSeconds);
+}
+
+// SIGALRM: --max-time ran out (the same stop as Ctrl-C, reported as the limit), or the grace
+// after a stop request did.
+extern "C" void on_alarm(int) {
+  if (g_interrupted.exchange(true)) {
+    constexpr char limit[] = "\nerror: stopped by --max-time; the work could not be cancelled\n";
+    constexpr char user[] = "\nerror: interrupted; the work could not be cancelled\n";
+    if (g_timed_out) return leave_now(kExitBadInput, limit, sizeof limit - 1);
+    return leave_now(kExitInterrupted, user, sizeof user - 1);
+  }
+  g_timed_out = true;
+  ::alarm(kGraceSeconds);
 }
 }  // namespace
 
@@ -61,6 +75,10 @@ void install_interrupt_handler() {
   sigemptyset(&sa.sa_mask);
   sigaction(SIGINT, &sa, nullptr);
   sigaction(SIGTERM, &sa, nullptr);
+  struct sigaction al {};
+  al.sa_handler = on_alarm;
+  sigemptyset(&al.sa_mask);
+  sigaction(SIGALRM, &al, nullptr);
 }
 
 void add_limit_options(CLI::App& app, Limits& l) {
@@ -87,11 +105,7 @@ bool install_limits(const Limits& l) {
     }
 #endif
   }
-  if (l.max_time_s > 0) {
-    struct sigaction sa {};
-    sa.sa_handler = on_alarm;
-    sigemptyset(&sa.sa_mask);
-    sigaction(SIGALRM, &sa, nullptr);
+  if (l.max_time_s > 0) {  // on_alarm is installed with the interrupt handler
     struct itimerval t {};
     t.it_value.tv_sec = static_cast<time_t>(l.max_time_s);
     t.it_value.tv_usec = static_cast<suseconds_t>((l.max_time_s - std::floor(l.max_time_s)) * 1e6);

@@ -425,5 +425,76 @@ TEST(HostileInput, SeveralProfilesLoadInOrder) {
   EXPECT_NE(g.find("G1 Y190 E"), std::string::npos);
 }
 
+// lib3mf's reader walks nested components once per object before we can count them (9
+// levels of 10 took it 37 s), and it cannot be cancelled: Ctrl-C and --max-time now leave
+// after a grace of 10 s instead of being ignored until it is done (hostile input #21.9).
+TEST(HostileInput, StopsWhileALibraryCannotBeCancelled) {
+  const fs::path dir = test::temp_dir("hostile_3mf_nest");
+  const fs::path pkg = dir / "pkg";
+  fs::create_directories(pkg / "_rels");
+  fs::create_directories(pkg / "3D");
+  test::write_bytes(pkg / "[Content_Types].xml",
+                    "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<Types xmlns=\"http://"
+                    "schemas.openxmlformats.org/package/2006/content-types\"><Default "
+                    "Extension=\"rels\" ContentType=\"application/vnd.openxmlformats-package."
+                    "relationships+xml\"/><Default Extension=\"model\" ContentType=\"application/"
+                    "vnd.ms-package.3dmanufacturing-3dmodel+xml\"/></Types>");
+  test::write_bytes(pkg / "_rels" / ".rels",
+                    "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<Relationships xmlns=\"http://"
+                    "schemas.openxmlformats.org/package/2006/relationships\"><Relationship "
+                    "Target=\"/3D/3dmodel.model\" Id=\"rel0\" Type=\"http://schemas.microsoft."
+                    "com/3dmanufacturing/2013/01/3dmodel\"/></Relationships>");
+  std::string model =
+      "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<model unit=\"millimeter\" xmlns=\"http://"
+      "schemas.microsoft.com/3dmanufacturing/core/2015/02\"><resources><object id=\"1\" "
+      "type=\"model\"><mesh><vertices><vertex x=\"0\" y=\"0\" z=\"0\"/><vertex x=\"1\" y=\"0\" "
+      "z=\"0\"/><vertex x=\"0\" y=\"1\" z=\"0\"/><vertex x=\"0\" y=\"0\" z=\"1\"/></vertices>"
+      "<triangles><triangle v1=\"0\" v2=\"2\" v3=\"1\"/><triangle v1=\"0\" v2=\"1\" v3=\"3\"/>"
+      "<triangle v1=\"1\" v2=\"2\" v3=\"3\"/><triangle v1=\"0\" v2=\"3\" v3=\"2\"/></triangles>"
+      "</mesh></object>";
+  for (int id = 2; id <= 10; ++id) {
+    model += "<object id=\"" + std::to_string(id) + "\" type=\"model\"><components>";
+    for (int k = 0; k < 10; ++k)
+      model += "<component objectid=\"" + std::to_string(id - 1) +
+               "\" transform=\"1 0 0 0 1 0 0 0 1 " + std::to_string(k) + " 0 0\"/>";
+    model += "</components></object>";
+  }
+  model += "</resources><build><item objectid=\"10\"/></build></model>";
+  test::write_bytes(pkg / "3D" / "3dmodel.model", model);
+  const fs::path file = dir / "nested.3mf";
+  ASSERT_EQ(std::system(("cd " + pkg.string() + " && zip -q -X -r " + file.string() +
+                         " '[Content_Types].xml' _rels 3D")
+                            .c_str()),
+            0);
+  for (const bool by_limit : {false, true}) {
+    std::vector<std::string> args = {NONPLANAR_CLI, "analyze", file.string()};
+    if (by_limit) args.insert(args.end(), {"--max-time", "0.5"});
+    std::vector<char*> argv;
+    for (auto& a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    const fs::path log = dir / (by_limit ? "limit.err" : "int.err");
+    posix_spawn_file_actions_t fa;
+    posix_spawn_file_actions_init(&fa);
+    posix_spawn_file_actions_addopen(&fa, STDERR_FILENO, log.c_str(), O_WRONLY | O_CREAT, 0644);
+    pid_t pid = 0;
+    ASSERT_EQ(posix_spawn(&pid, NONPLANAR_CLI, &fa, nullptr, argv.data(), environ), 0);
+    posix_spawn_file_actions_destroy(&fa);
+    for (int k = 0; k < 1000 && !catches_sigint(pid); ++k)
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    std::this_thread::sleep_for(std::chrono::milliseconds(500));
+    const auto t0 = std::chrono::steady_clock::now();
+    if (!by_limit) ::kill(pid, SIGINT);
+    int status = 0;
+    ASSERT_EQ(::waitpid(pid, &status, 0), pid);
+    const double waited =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    ASSERT_TRUE(WIFEXITED(status)) << "killed by signal " << WTERMSIG(status);
+    EXPECT_EQ(WEXITSTATUS(status), by_limit ? 2 : 130) << test::read_bytes(log);
+    EXPECT_NE(test::read_bytes(log).find("could not be cancelled"), std::string::npos)
+        << test::read_bytes(log);
+    EXPECT_LT(waited, 20.0);  // 10 s of grace, and lib3mf alone takes 37 s
+  }
+}
+
 }  // namespace
 }  // namespace nonplanar
