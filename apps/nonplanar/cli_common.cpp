@@ -13,17 +13,8 @@
 #include <filesystem>
 
 #include "core/atomic_file.hpp"
+#include "core/sanitizers.hpp"
 #include "slice/external_engine.hpp"
-
-// AddressSanitizer reserves terabytes of address space: RLIMIT_AS cannot work under it.
-// (GCC defines __SANITIZE_ADDRESS__; clang answers __has_feature.)
-#if defined(__SANITIZE_ADDRESS__)
-#define NONPLANAR_ASAN 1
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-#define NONPLANAR_ASAN 1
-#endif
-#endif
 
 namespace nonplanar::cli {
 namespace {
@@ -146,14 +137,16 @@ void ProfileOptions::add_to(CLI::App& cmd, const std::string& what) {
                  "nozzle_cone_angle=40, toolhead_shape=prusa-mk3s; docs/toolhead.md)");
 }
 
-Expected<std::pair<std::string, std::string>> apply_setting(PrintConfig& c, const std::string& kv) {
+Expected<Setting> apply_setting(PrintConfig& c, const std::string& kv, bool unknown_ok) {
   const auto eq = kv.find('=');
   if (eq == std::string::npos)
     return Error{Status::invalid_argument, "--set: expected KEY=VALUE, got '" + kv + "'"};
-  std::pair<std::string, std::string> p{kv.substr(0, eq), kv.substr(eq + 1)};
-  auto r = set_config_value(c, p.first, p.second);
+  Setting p{kv.substr(0, eq), kv.substr(eq + 1)};
+  auto r = set_config_value(c, p.key, p.value);
   if (!r) return Error{Status::invalid_argument, "--" + r.error().message};
-  if (!*r) return Error{Status::invalid_argument, "unknown setting '" + p.first + "'"};
+  p.known = *r;
+  if (!p.known && !unknown_ok)
+    return Error{Status::invalid_argument, "unknown setting '" + p.key + "'"};
   return p;
 }
 

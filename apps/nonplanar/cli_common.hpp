@@ -67,8 +67,15 @@ struct ProfileOptions {
 /// max_angle in (0, 90) degrees (NaN refused), or the error every subcommand gives.
 Expected<bool> check_max_angle(double max_angle_deg);
 
-/// Applies "KEY=VALUE" to c; the error names the key ("--set: …" for a malformed pair).
-Expected<std::pair<std::string, std::string>> apply_setting(PrintConfig& c, const std::string& kv);
+/// One "KEY=VALUE" override; `known` is false for a key our settings do not have.
+struct Setting {
+  std::string key, value;
+  bool known = true;
+};
+/// Applies "KEY=VALUE" to c; the error names the key ("--set: …" for a malformed pair). An
+/// unknown key is an error unless `unknown_ok` (then it comes back with known = false, for
+/// another slicer to take).
+Expected<Setting> apply_setting(PrintConfig& c, const std::string& kv, bool unknown_ok = false);
 
 /// The analysis stage's options (--max-angle, --tau, ...), added to a subcommand.
 void add_analysis_options(CLI::App& cmd, AnalysisParams& p);

@@ -56,19 +56,12 @@ int run(const SliceOptions& o) {
   overrides.insert(overrides.end(), o.sets.begin(), o.sets.end());
   std::vector<std::string> engine_only;
   for (const std::string& kv : overrides) {
-    auto applied = apply_setting(cfg, kv);
-    const auto eq = kv.find('=');
     // A key only the engine knows (brim_width, support_material, ...) goes to it alone.
-    if (!applied && engine.engine != Engine::builtin && eq != std::string::npos) {
-      const std::string key = kv.substr(0, eq), value = kv.substr(eq + 1);
-      if (auto known = set_config_value(cfg, key, value); known && !*known) {
-        engine.overrides.emplace_back(key, value);
-        engine_only.push_back(key);
-        continue;
-      }
-    }
+    auto applied = apply_setting(cfg, kv, engine.engine != Engine::builtin);
     if (!applied) return report_error(applied.error());
-    if (!is_nonplanar_key(applied->first)) engine.overrides.push_back(std::move(*applied));
+    if (!applied->known) engine_only.push_back(applied->key);
+    if (!is_nonplanar_key(applied->key))
+      engine.overrides.emplace_back(std::move(applied->key), std::move(applied->value));
   }
   if (auto v = validate_config(cfg); !v) return report_error(v.error());
   if (auto a = check_max_angle(o.max_angle); !a) return report_error(a.error());

@@ -70,12 +70,14 @@ struct GcodeParams {
 /// extrusion_width, and extrusion_width for the other widths). Every set_config_value() resolves
 /// them all again, so the result does not depend on the order of the keys (`prusa-slicer --save`
 /// writes them alphabetically, nozzle_diameter after the widths).
+/// An empty text was not given, and its field keeps its default. The widths always follow
+/// their rule: by default automatic, and 250 % of the first layer (0.5 mm at 0.2 mm).
 struct RelativeSettings {
-  std::string first_layer_height = "0.2";
+  std::string first_layer_height;
   std::string extrusion_width = "0", perimeter_width = "0", infill_width = "0",
               external_perimeter_width = "0", first_layer_width = "250%";
-  std::string external_perimeter_speed = "25", solid_infill_speed = "60",
-              top_solid_infill_speed = "40", first_layer_speed = "20";
+  std::string external_perimeter_speed, solid_infill_speed, top_solid_infill_speed,
+      first_layer_speed;
   bool start_gcode_given = false;  ///< else the default start G-code is made for the bed
 };
 

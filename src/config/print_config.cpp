@@ -65,26 +65,30 @@ void resolve_relative(PrintConfig& c) {
   auto of = [](const std::string& text, double base) {
     return number_or_percent(text, base).value_or(0.0);  // checked when it was set
   };
+  // An empty text was never given: the field keeps its own value.
+  auto set = [&](double& field, const std::string& text, double base) {
+    if (!text.empty()) field = of(text, base);
+  };
   const double lh = c.slice.layer_height;
-  c.slice.first_layer_height = of(r.first_layer_height, lh);
+  set(c.slice.first_layer_height, r.first_layer_height, lh);
   const double w0 = of(r.extrusion_width, lh);
   const double w = w0 > 0 ? w0 : 1.125 * t.nozzle_diameter;
   auto role = [&](const std::string& text, double base) {
-    return of(text, base) > 0 ? of(text, base) : w;
+    const double v = of(text, base);
+    return v > 0 ? v : w;
   };
   t.extrusion_width = role(r.infill_width, lh);
   t.perimeter_width = role(r.perimeter_width, lh);
   t.external_perimeter_width = role(r.external_perimeter_width, lh);
   t.first_layer_width = role(r.first_layer_width, c.slice.first_layer_height);
-  t.external_perimeter_speed = of(r.external_perimeter_speed, t.perimeter_speed);
-  t.solid_infill_speed = of(r.solid_infill_speed, t.infill_speed);
-  t.top_solid_infill_speed = of(r.top_solid_infill_speed, t.solid_infill_speed);
-  t.first_layer_speed = of(r.first_layer_speed, t.perimeter_speed);
+  set(t.external_perimeter_speed, r.external_perimeter_speed, t.perimeter_speed);
+  set(t.solid_infill_speed, r.solid_infill_speed, t.infill_speed);
+  set(t.top_solid_infill_speed, r.top_solid_infill_speed, t.solid_infill_speed);
+  set(t.first_layer_speed, r.first_layer_speed, t.perimeter_speed);
   if (!r.start_gcode_given) c.gcode.start_gcode = default_start_gcode(c.bed_min, c.bed_max);
 }
 
-}  // namespace
-
+// One key, without resolving the relative settings (set_config_value does that after it).
 Expected<bool> set_value(PrintConfig& c, const std::string& key, const std::string& value) {
   ToolpathParams& t = c.paths;
   GcodeParams& g = c.gcode;
@@ -237,6 +241,8 @@ Expected<bool> set_value(PrintConfig& c, const std::string& key, const std::stri
   }
   return false;
 }
+
+}  // namespace
 
 Expected<bool> set_config_value(PrintConfig& c, const std::string& key, const std::string& value) {
   auto r = set_value(c, key, value);

@@ -469,8 +469,7 @@ Expected<ForeignGcode> map_foreign_gcode(std::string_view text, const LayerField
         else if (a == 'E')
           // G91 makes E relative too, as M83 does (Klipper, RepRapFirmware, Marlin 1 and
           // PrusaSlicer's viewer; read as absolute, a G91 retraction became 75x extrusion).
-          m.has_e = true, m.de = rel_e || rel_xyz ? *v : *v - e,
-          e = rel_e || rel_xyz ? e + *v : *v;
+          m.has_e = true, m.de = rel_e || rel_xyz ? *v : *v - e, e = rel_e || rel_xyz ? e + *v : *v;
         else if (a == 'F')
           m.f = *v;
         else if (in_print)

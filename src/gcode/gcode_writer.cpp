@@ -75,51 +75,58 @@ std::string command_of(std::string_view line) {
   return w;
 }
 
-// Does `block` hold `word` as a command? (A comment that mentions M190 is not one.)
-bool has_command(std::string_view block, std::string_view word) {
+// Calls f(line, n) for each line of `block` (n from 1) until f returns true; true if one did.
+template <class F>
+bool any_line(std::string_view block, F f) {
+  int n = 0;
   for (std::size_t p = 0; p < block.size();) {
     const std::size_t e = std::min(block.find('\n', p), block.size());
-    if (command_of(block.substr(p, e - p)) == word) return true;
+    if (f(block.substr(p, e - p), ++n)) return true;
     p = e + 1;
   }
   return false;
 }
 
+// Does `block` hold `word` as a command? (A comment that mentions M190 is not one.)
+bool has_command(std::string_view block, std::string_view word) {
+  return any_line(block, [&](std::string_view l, int) { return command_of(l) == word; });
+}
+
 // The first placeholder or macro left in `block` outside comments, e.g. "{max_layer_z}" or
 // "[printer_model]"; "" when none.
 std::string leftover_placeholder(std::string_view block) {
-  for (std::size_t p = 0; p < block.size();) {
-    const std::size_t e = std::min(block.find('\n', p), block.size());
-    std::string_view l = block.substr(p, e - p);
+  std::string found;
+  any_line(block, [&](std::string_view l, int) {
     l = l.substr(0, l.find(';'));
     for (const auto& [open, close] : {std::pair{'{', '}'}, std::pair{'[', ']'}})
       if (const auto a = l.find(open); a != std::string_view::npos) {
         const auto b = l.find(close, a);
-        return std::string(l.substr(a, b == std::string_view::npos ? l.npos : b - a + 1));
+        found = l.substr(a, b == std::string_view::npos ? l.npos : b - a + 1);
+        return true;
       }
-    p = e + 1;
-  }
-  return {};
+    return false;
+  });
+  return found;
 }
 
 // The first line of `block` a firmware cannot take as written: longer than 255 characters
 // (Marlin reads 96), or with a control byte anywhere or a non-ASCII byte outside the
 // comment (the settings fuzzer sent binary through end_gcode). "" when all are fine.
 std::string unprintable_line(std::string_view block) {
-  int n = 0;
-  for (std::size_t p = 0; p < block.size();) {
-    const std::size_t e = std::min(block.find('\n', p), block.size());
-    const std::string_view l = block.substr(p, e - p);
-    p = e + 1, ++n;
-    if (l.size() > 255) return "line " + std::to_string(n) + " is longer than 255 characters";
+  std::string why;
+  any_line(block, [&](std::string_view l, int n) {
+    if (l.size() > 255)
+      return why = "line " + std::to_string(n) + " is longer than 255 characters", true;
     const std::size_t semi = std::min(l.find(';'), l.size());
     for (std::size_t i = 0; i < l.size(); ++i) {
       const auto b = static_cast<unsigned char>(l[i]);
       if ((b < 0x20 && b != '\t' && b != '\r') || b == 0x7f || (b >= 0x80 && i < semi))
-        return "line " + std::to_string(n) + " holds a byte that is not printable ASCII";
+        return why = "line " + std::to_string(n) + " holds a byte that is not printable ASCII",
+               true;
     }
-  }
-  return {};
+    return false;
+  });
+  return why;
 }
 
 bool on_bed(const Vec3& p, const PrintConfig& c) {

@@ -137,8 +137,8 @@ TEST(MapForeignGcode, RefusesWhatItCannotMapNamingTheLine) {
   EXPECT_NE(rel->text.find("G1 X5.000 Y2.000 E2.00000"), std::string::npos) << rel->text;
   EXPECT_EQ(rel->text.find("\nG91\n"), std::string::npos);
   // M83 mid-print: the E that follows is relative, in the file and in what is written.
-  auto m83 = map_foreign_gcode(head + "G1 X2 Y1 E2\nM83\nG1 X3 Y1 E0.5\nM82\nG1 X4 Y1 E3\n",
-                               *field, {}, {});
+  auto m83 = map_foreign_gcode(head + "G1 X2 Y1 E2\nM83\nG1 X3 Y1 E0.5\nM82\nG1 X4 Y1 E3\n", *field,
+                               {}, {});
   ASSERT_TRUE(m83) << m83.error().message;
   const std::string& t = m83->text;
   EXPECT_NE(t.find("M83\nG1 X3.000 Y1.000 E0.50000"), std::string::npos) << t;

@@ -10,6 +10,37 @@
 namespace nonplanar {
 namespace {
 
+// A cube mesh object in a fresh lib3mf model (released by the caller with the model).
+NMR::PLib3MFModelMeshObject* add_cube(NMR::PLib3MFModel* model) {
+  const TriangleMesh cube = test::box({0, 0, 0}, {1, 1, 1});
+  NMR::PLib3MFModelMeshObject* obj = nullptr;
+  EXPECT_EQ(NMR::lib3mf_model_addmeshobject(model, &obj), 0);
+  std::vector<NMR::MODELMESHVERTEX> v(cube.vertices.size());
+  for (std::size_t i = 0; i < v.size(); ++i)
+    for (int k = 0; k < 3; ++k) v[i].m_fPosition[k] = static_cast<float>(cube.vertices[i][k]);
+  std::vector<NMR::MODELMESHTRIANGLE> t(cube.faces.size());
+  for (std::size_t i = 0; i < t.size(); ++i)
+    for (int k = 0; k < 3; ++k) t[i].m_nIndices[k] = static_cast<DWORD>(cube.faces[i][k]);
+  EXPECT_EQ(NMR::lib3mf_meshobject_setgeometry(obj, v.data(), static_cast<DWORD>(v.size()),
+                                               t.data(), static_cast<DWORD>(t.size())),
+            0);
+  return obj;
+}
+
+std::string write_model(NMR::PLib3MFModel* model, const std::filesystem::path& file) {
+  NMR::PLib3MFModelWriter* writer = nullptr;
+  EXPECT_EQ(NMR::lib3mf_model_querywriter(model, "3mf", &writer), 0);
+  EXPECT_EQ(NMR::lib3mf_writer_writetofileutf8(writer, file.c_str()), 0);
+  NMR::lib3mf_release(writer);
+  return test::read_bytes(file);
+}
+
+NMR::MODELTRANSFORM identity() {
+  NMR::MODELTRANSFORM m{};
+  for (int k = 0; k < 3; ++k) m.m_fFields[k][k] = 1;
+  return m;
+}
+
 TEST(ThreeMf, RoundTrip) {
   const auto dir = test::temp_dir("3mf_roundtrip");
   const TriangleMesh m =
@@ -26,32 +57,18 @@ TEST(ThreeMf, RoundTrip) {
 // Two build items of one object, each with its own transform: both must come in, moved.
 TEST(ThreeMf, BuildItemsAndTransformsAreApplied) {
   const auto dir = test::temp_dir("3mf_transform");
-  const TriangleMesh cube = test::box({0, 0, 0}, {1, 1, 1});
   NMR::PLib3MFModel* model = nullptr;
-  NMR::PLib3MFModelMeshObject* obj = nullptr;
   ASSERT_EQ(NMR::lib3mf_createmodel(&model), 0);
-  ASSERT_EQ(NMR::lib3mf_model_addmeshobject(model, &obj), 0);
-  std::vector<NMR::MODELMESHVERTEX> v(cube.vertices.size());
-  for (std::size_t i = 0; i < v.size(); ++i)
-    for (int k = 0; k < 3; ++k) v[i].m_fPosition[k] = static_cast<float>(cube.vertices[i][k]);
-  std::vector<NMR::MODELMESHTRIANGLE> t(cube.faces.size());
-  for (std::size_t i = 0; i < t.size(); ++i)
-    for (int k = 0; k < 3; ++k) t[i].m_nIndices[k] = static_cast<DWORD>(cube.faces[i][k]);
-  ASSERT_EQ(NMR::lib3mf_meshobject_setgeometry(obj, v.data(), static_cast<DWORD>(v.size()),
-                                               t.data(), static_cast<DWORD>(t.size())),
-            0);
-  NMR::MODELTRANSFORM a{}, b{};
-  for (int k = 0; k < 3; ++k) a.m_fFields[k][k] = b.m_fFields[k][k] = 1;
+  NMR::PLib3MFModelMeshObject* obj = add_cube(model);
+  NMR::MODELTRANSFORM a = identity(), b = identity();
   a.m_fFields[0][3] = 10;  // translate x by 10
   b.m_fFields[0][0] = 2;   // scale x by 2, then move z by 5
   b.m_fFields[2][3] = 5;
   NMR::PLib3MFModelBuildItem *ia = nullptr, *ib = nullptr;
   ASSERT_EQ(NMR::lib3mf_model_addbuilditem(model, obj, &a, &ia), 0);
   ASSERT_EQ(NMR::lib3mf_model_addbuilditem(model, obj, &b, &ib), 0);
-  NMR::PLib3MFModelWriter* writer = nullptr;
-  ASSERT_EQ(NMR::lib3mf_model_querywriter(model, "3mf", &writer), 0);
-  ASSERT_EQ(NMR::lib3mf_writer_writetofileutf8(writer, (dir / "two.3mf").c_str()), 0);
-  for (auto* p : {writer, ia, ib, obj, model}) NMR::lib3mf_release(p);
+  write_model(model, dir / "two.3mf");
+  for (auto* p : {static_cast<NMR::PLib3MFBase*>(ia), ib, obj, model}) NMR::lib3mf_release(p);
 
   auto r = load_mesh(dir / "two.3mf", test::unplaced(), {});
   ASSERT_TRUE(r) << r.error().message;
@@ -82,37 +99,6 @@ TEST(ThreeMfErrors, ZipThatIsNot3mfAndRandomBytes) {
   EXPECT_NE(r.error().message.find("not a valid 3MF"), std::string::npos) << r.error().message;
   EXPECT_FALSE(io::parse_3mf("this is not a zip at all"));
   EXPECT_FALSE(io::parse_3mf(""));
-}
-
-// A cube mesh object in a fresh lib3mf model (released by the caller with the model).
-NMR::PLib3MFModelMeshObject* add_cube(NMR::PLib3MFModel* model) {
-  const TriangleMesh cube = test::box({0, 0, 0}, {1, 1, 1});
-  NMR::PLib3MFModelMeshObject* obj = nullptr;
-  EXPECT_EQ(NMR::lib3mf_model_addmeshobject(model, &obj), 0);
-  std::vector<NMR::MODELMESHVERTEX> v(cube.vertices.size());
-  for (std::size_t i = 0; i < v.size(); ++i)
-    for (int k = 0; k < 3; ++k) v[i].m_fPosition[k] = static_cast<float>(cube.vertices[i][k]);
-  std::vector<NMR::MODELMESHTRIANGLE> t(cube.faces.size());
-  for (std::size_t i = 0; i < t.size(); ++i)
-    for (int k = 0; k < 3; ++k) t[i].m_nIndices[k] = static_cast<DWORD>(cube.faces[i][k]);
-  EXPECT_EQ(NMR::lib3mf_meshobject_setgeometry(obj, v.data(), static_cast<DWORD>(v.size()),
-                                               t.data(), static_cast<DWORD>(t.size())),
-            0);
-  return obj;
-}
-
-std::string write_model(NMR::PLib3MFModel* model, const std::filesystem::path& file) {
-  NMR::PLib3MFModelWriter* writer = nullptr;
-  EXPECT_EQ(NMR::lib3mf_model_querywriter(model, "3mf", &writer), 0);
-  EXPECT_EQ(NMR::lib3mf_writer_writetofileutf8(writer, file.c_str()), 0);
-  NMR::lib3mf_release(writer);
-  return test::read_bytes(file);
-}
-
-NMR::MODELTRANSFORM identity() {
-  NMR::MODELTRANSFORM m{};
-  for (int k = 0; k < 3; ++k) m.m_fFields[k][k] = 1;
-  return m;
 }
 
 // Hostile-input #9: nested components that expand past the triangle limit are refused after
