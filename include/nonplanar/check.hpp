@@ -9,10 +9,9 @@
 
 #include "nonplanar/config.hpp"
 #include "nonplanar/context.hpp"
-#include "nonplanar/gcode.hpp"
 #include "nonplanar/mesh.hpp"
+#include "nonplanar/program.hpp"
 #include "nonplanar/toolhead.hpp"
-#include "nonplanar/toolpaths.hpp"
 
 namespace nonplanar {
 

@@ -1,6 +1,6 @@
-// Stage gcode: the one G-code reader (into moves, for check and for mapping another slicer's
-// G-code back) and a small stateful emitter turning toolpaths into G-code (no arcs), with the
-// annotations PrusaSlicer's and OrcaSlicer's previews read, written atomically.
+// Stage gcode: the built-in engine's writer, turning toolpaths into G-code (no arcs) through
+// the one emitter (program/), with the annotations PrusaSlicer's and OrcaSlicer's previews
+// read, written atomically. G-code is read by read_gcode_program (program.hpp).
 #pragma once
 
 #include <filesystem>
@@ -10,25 +10,10 @@
 #include <vector>
 
 #include "nonplanar/config.hpp"
+#include "nonplanar/program.hpp"
 #include "nonplanar/toolpaths.hpp"
 
 namespace nonplanar {
-
-/// One G0/G1 move with what it deposited.
-struct PrintMove {
-  Vec3 from{0, 0, 0}, to{0, 0, 0};
-  double filament = 0;     ///< mm of filament pushed (negative: retraction)
-  bool extruding = false;  ///< filament > 0 and the nozzle moved in XY
-  std::string type;        ///< the ;TYPE: in force ("" before any)
-  int layer = -1;          ///< ;LAYER_CHANGE count − 1
-  double width = 0.45;     ///< ;WIDTH: in force
-  int line = 0;            ///< 1-based line in the file (0 for moves made in memory)
-};
-
-/// Reads G-code strictly: G0/G1 (X Y Z E F), G92, G90/G91, M82/M83, the comments ;TYPE:,
-/// ;WIDTH:, ;LAYER_CHANGE; other M-codes and motionless G-codes (G4, G10/G11, G21, G28, G29,
-/// G80) pass. Arcs (G2/G3), inches (G20) and unknown G-codes are errors naming the line.
-Expected<std::vector<PrintMove>> read_gcode_moves(std::string_view text);
 
 /// The same moves straight from toolpaths (for the check before a file is written); when
 /// `keep` is given, only the paths it accepts, called with each path and its layer (the

@@ -2,6 +2,7 @@
 // carrying its own height per point so non-planar paths can use the same types.
 #pragma once
 
+#include <string_view>
 #include <vector>
 
 #include "nonplanar/slice.hpp"
@@ -18,6 +19,9 @@ enum class ExtrusionRole {
 };
 /// PrusaSlicer's ;TYPE: names ("External perimeter", "Internal infill", "Skirt/Brim", ...).
 const char* role_name(ExtrusionRole r);
+/// The role of a ;TYPE: name, PrusaSlicer's and OrcaSlicer's ("Overhang perimeter" is an
+/// external one, "Ironing" a top skin's, "Brim" a skirt's); anything else is solid infill.
+ExtrusionRole role_from_name(std::string_view type);
 
 /// One extrusion: a polyline (closed loops repeat their first point at the end). points[i]
 /// carries its z; height[i] is the layer thickness under point i (mm); width in mm.

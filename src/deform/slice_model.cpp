@@ -11,6 +11,7 @@
 #include "deform/shell_toolpaths.hpp"
 #include "layers/banded_field.hpp"
 #include "nonplanar/deform.hpp"
+#include "nonplanar/gcode.hpp"
 #include "nonplanar/pipeline.hpp"
 #include "slice/external_engine.hpp"
 

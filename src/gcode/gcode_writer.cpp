@@ -5,7 +5,6 @@
 #include <cctype>
 #include <cinttypes>
 #include <cmath>
-#include <cstdarg>
 #include <cstdio>
 #include <optional>
 #include <string>
@@ -13,6 +12,7 @@
 
 #include "core/atomic_file.hpp"
 #include "nonplanar/gcode.hpp"
+#include "program/gcode_text.hpp"
 
 namespace nonplanar {
 
@@ -159,34 +159,32 @@ std::optional<Error> check_block_on_bed(const std::string& key, const std::strin
   return std::nullopt;
 }
 
+// The built-in engine's program, written through the one emitter (program/gcode_text.hpp):
+// travels with retraction and lift, extrusions, and the bed check on every point.
 class Emitter {
  public:
-  explicit Emitter(const PrintConfig& c) : c_(c), g_(c.gcode), tip_radius_(c.toolhead.tip_radius) {}
-  std::string out;
+  explicit Emitter(const PrintConfig& c)
+      : c_(c), g_(c.gcode), tip_radius_(c.toolhead.tip_radius), w_(c.gcode.relative_e) {}
   /// The first point off the bed, or a line too long to format: the program is refused.
   std::optional<Error> fault;
   const char* what = "the print";  ///< what is being emitted, for the fault's message
 
-  void raw(const std::string& s) { out += s; }
-  void comment(const std::string& s) { out += ";" + s + "\n"; }
-  void line(const char* f, ...) __attribute__((format(printf, 2, 3))) {
-    char buf[256];
-    va_list ap;
-    va_start(ap, f);
-    const int n = std::vsnprintf(buf, sizeof buf, f, ap);
-    va_end(ap);
-    if ((n < 0 || n >= static_cast<int>(sizeof buf)) && !fault)
-      fault = Error{Status::internal_error, "a G-code line would not fit 255 characters"};
-    out += buf;
-    out += '\n';
+  std::string& out() { return w_.out; }
+  const std::optional<Error>& format_fault() const { return w_.fault; }
+  void raw(const std::string& s) { w_.block(s); }
+  void comment(const std::string& s) { w_.raw(";" + s); }
+  template <class... A>
+  void line(const char* f, A... a) {
+    w_.line(f, a...);
   }
+  void line(const char* s) { w_.raw(s); }
   void fan(int percent) {
     if (percent <= 0) return line("M107");
     if (g_.flavor == GcodeFlavor::reprapfirmware) return line("M106 S%.2f", percent / 100.0);
     line("M106 S%d", static_cast<int>(std::lround(2.55 * percent)));
   }
   void reset_e() {
-    if (!g_.relative_e) line("G92 E0"), e_ = 0;
+    if (!g_.relative_e) line("G92 E0"), w_.set_e(0);
   }
   void retract() {
     if (retracted_ || g_.retract_length <= 0) return;
@@ -204,6 +202,7 @@ class Emitter {
   // went 0.12 mm under a neighbouring line on a wave; TravelsClearPrintedMaterial found it.)
   void travel(const Vec3& p, double speed, bool curved, double safe_z, double slope) {
     check_on_bed(p, what);  // a travel to the skirt is the skirt's problem
+    const double f = feed(speed);
     if (curved && have_pos_) {
       const double d = (p.head<2>() - pos_.head<2>()).norm();
       if (d < 1e-6 && std::abs(p.z() - pos_.z()) < 1e-6) return;
@@ -211,9 +210,7 @@ class Emitter {
           travel_height(pos_, p, safe_z, slope, tip_radius_, travel_lift(g_.retract_lift));
       if (!std::isnan(lift)) {
         if (d > g_.retract_before_travel) retract();
-        line("G1 Z%.3f F%d", lift, static_cast<int>(speed * 60));
-        line("G1 X%.3f Y%.3f F%d", p.x(), p.y(), static_cast<int>(speed * 60));
-        line("G1 Z%.3f F%d", p.z(), static_cast<int>(speed * 60));
+        program::lifted_travel(w_, pos_, p, lift, f, f);
         pos_ = p;
         return;
       }
@@ -222,8 +219,7 @@ class Emitter {
     if (!have_pos_) {
       // Wherever the start G-code left the nozzle, the way to the print is long: retract.
       retract();
-      line("G1 Z%.3f F%d", p.z(), static_cast<int>(speed * 60));
-      line("G1 X%.3f Y%.3f F%d", p.x(), p.y(), static_cast<int>(speed * 60));
+      z_to(p, f), xy_to(p, f);
       pos_ = p, have_pos_ = true;
       return;
     }
@@ -231,32 +227,39 @@ class Emitter {
     const bool long_move = d > g_.retract_before_travel;
     if (long_move) retract();
     if (long_move && g_.retract_lift > 0)
-      line("G1 Z%.3f F%d", std::max(pos_.z(), p.z()) + g_.retract_lift,
-           static_cast<int>(speed * 60));
+      z_to(Vec3(p.x(), p.y(), std::max(pos_.z(), p.z()) + g_.retract_lift), f);
     else if (p.z() > pos_.z() + 1e-9)
-      line("G1 Z%.3f F%d", p.z(), static_cast<int>(speed * 60));
-    line("G1 X%.3f Y%.3f F%d", p.x(), p.y(), static_cast<int>(speed * 60));
-    if ((long_move && g_.retract_lift > 0) || p.z() < pos_.z() - 1e-9)
-      line("G1 Z%.3f F%d", p.z(), static_cast<int>(speed * 60));
+      z_to(p, f);
+    xy_to(p, f);
+    if ((long_move && g_.retract_lift > 0) || p.z() < pos_.z() - 1e-9) z_to(p, f);
     pos_ = p;
   }
   void extrude(const Vec3& p, double de, double speed) {
     check_on_bed(p, what);
     unretract();
-    e_ += de;
-    const double e = g_.relative_e ? de : e_;
-    if (std::abs(p.z() - pos_.z()) > 1e-9)
-      line("G1 X%.3f Y%.3f Z%.3f E%.5f F%d", p.x(), p.y(), p.z(), e, static_cast<int>(speed * 60));
-    else
-      line("G1 X%.3f Y%.3f E%.5f F%d", p.x(), p.y(), e, static_cast<int>(speed * 60));
+    program::MoveWords m;
+    m.xy = true, m.z = std::abs(p.z() - pos_.z()) > 1e-9, m.de = de, m.f = feed(speed);
+    w_.move(p, m);
     pos_ = p;
   }
-  double total_e = 0;
 
  private:
+  // Feed rates are written as whole mm/min, truncated as they always were.
+  static double feed(double mm_per_s) { return static_cast<int>(mm_per_s * 60); }
+  void z_to(const Vec3& p, double f) {
+    program::MoveWords m;
+    m.z = true, m.f = f;
+    w_.move(p, m);
+  }
+  void xy_to(const Vec3& p, double f) {
+    program::MoveWords m;
+    m.xy = true, m.f = f;
+    w_.move(p, m);
+  }
   void move_e(double de, double speed, const char* why) {
-    e_ += de;
-    line("G1 E%.5f F%d ; %s", g_.relative_e ? de : e_, static_cast<int>(speed * 60), why);
+    program::MoveWords m;
+    m.de = de, m.f = feed(speed), m.comment = why;
+    w_.move(pos_, m);
   }
   void check_on_bed(const Vec3& p, const char* kind) {
     if (fault || on_bed(p, c_)) return;
@@ -269,9 +272,9 @@ class Emitter {
   const PrintConfig& c_;
   const GcodeParams& g_;
   double tip_radius_;  ///< what a short hop must clear (travel_height)
+  program::GcodeText w_;
   Vec3 pos_ = Vec3::Zero();
   bool have_pos_ = false, retracted_ = false;
-  double e_ = 0;
 };
 
 }  // namespace
@@ -281,7 +284,7 @@ Expected<std::string> make_gcode(const std::vector<LayerToolpaths>& layers, cons
   const GcodeParams& g = c.gcode;
   if (auto e = check_custom_gcode(c); !e) return e.error();
   Emitter em(c);
-  em.out.reserve(1 << 20);
+  em.out().reserve(1 << 20);
   em.comment(" generated by nonplanar 0.1.0");
   for (const auto& h : header) em.comment(" " + h);
   em.line(";FLAVOR:%s", flavor_name(g.flavor));
@@ -334,12 +337,14 @@ Expected<std::string> make_gcode(const std::vector<LayerToolpaths>& layers, cons
     ctx.progress("gcode", static_cast<double>(i + 1) / static_cast<double>(layers.size()));
   }
   if (em.fault) return *em.fault;
+  if (em.format_fault()) return *em.format_fault();
   em.fan(0);
   em.raw(expand(g.end_gcode, c));
   em.line("; filament used [mm] = %.2f", filament);
   em.line("; filament used [cm3] = %.3f",
           filament * M_PI * 0.25 * g.filament_diameter * g.filament_diameter / 1000.0);
-  return std::move(em.out);
+  if (em.format_fault()) return *em.format_fault();
+  return std::move(em.out());
 }
 
 Expected<bool> check_custom_gcode(const PrintConfig& c) {

@@ -26,6 +26,16 @@ const char* role_name(ExtrusionRole r) {
   return "Custom";
 }
 
+ExtrusionRole role_from_name(std::string_view type) {
+  if (type == "External perimeter" || type == "Overhang perimeter")
+    return ExtrusionRole::external_perimeter;
+  if (type == "Perimeter") return ExtrusionRole::perimeter;
+  if (type == "Internal infill") return ExtrusionRole::internal_infill;
+  if (type == "Top solid infill" || type == "Ironing") return ExtrusionRole::top_solid_infill;
+  if (type == "Skirt/Brim" || type == "Skirt" || type == "Brim") return ExtrusionRole::skirt;
+  return ExtrusionRole::solid_infill;
+}
+
 double bead_spacing(double width, double height) {
   return width - height * (1.0 - M_PI / 4.0);
 }

@@ -9,6 +9,7 @@
 
 #include "deform/gate_zones.hpp"
 #include "nonplanar/deform.hpp"
+#include "nonplanar/gcode.hpp"
 #include "nonplanar/pipeline.hpp"
 #include "support/solids.hpp"
 

@@ -1,0 +1,125 @@
+// The print program in the middle (issue: one print program for both engines): G-code as
+// lines and moves, read by the one tolerant reader. The built-in engine's writer, `check`, and
+// the mapping of another slicer's G-code back onto curved layers all read and write G-code
+// through this module. Units: mm, mm of filament for E, mm/min for feed rates (as written).
+#pragma once
+
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "nonplanar/mesh.hpp"
+#include "nonplanar/status.hpp"
+
+namespace nonplanar {
+
+/// "No value given": a feed rate or an E the line did not have.
+inline constexpr double kNoValue = std::numeric_limits<double>::quiet_NaN();
+
+/// One G0/G1 line as read (or made): where it went and what it pushed.
+struct GcodeMove {
+  int line = 0;  ///< 1-based line of the file (0: made in memory)
+  Vec3 from{0, 0, 0}, to{0, 0, 0};
+  double de = 0;  ///< filament pushed (negative: retraction), mm
+  bool has_xy = false, has_z = false, has_e = false;  ///< the words the line had
+  double f = kNoValue;                                ///< the line's own F word (kNoValue: none)
+  double feed = kNoValue;  ///< the feed rate in force for it (its own or the last one given)
+  bool wipe = false;       ///< between ;WIPE_START and ;WIPE_END
+  std::string_view type;   ///< the ;TYPE: in force ("" before any); views the text read
+  double width = 0.45;     ///< the ;WIDTH: in force, mm
+  double height = 0.2;     ///< the layer's ;HEIGHT: (the planar thickness), mm
+  int layer = -1;          ///< ;LAYER_CHANGE count − 1
+  /// Pushes filament while moving in XY.
+  bool extruding() const { return de > 0 && has_xy && (to - from).head<2>().norm() > 1e-9; }
+};
+
+/// One line of the program, classified. `raw` is the line as written (no line end).
+struct GcodeLine {
+  enum class Kind : std::uint8_t {
+    text,            ///< passes as written: comments, M-codes, T, macros, G4, G28, ...
+    move,            ///< G0/G1: moves[move]
+    z_comment,       ///< the layer's ;Z: (inside the print)
+    height_comment,  ///< the layer's ;HEIGHT: (inside the print, the first after its change)
+    e_reset,         ///< G92 with E: value is the new E
+    e_mode,          ///< M82 / M83: value 1 for relative
+    xyz_relative,    ///< G91 (which makes E relative too)
+  };
+  Kind kind = Kind::text;
+  std::string_view raw;
+  int move = -1;
+  double value = 0;
+  int layer = -1;  ///< ;LAYER_CHANGE count − 1 at this line
+};
+
+/// A line the reader could not take: what the caller refuses depends on where it is.
+struct GcodeProblem {
+  int line = 0;  ///< 1-based
+  std::string why;
+  /// G28 / G29 (home, probe) move the head by themselves: fine before or after the print,
+  /// not inside it (nothing can map them). Other problems make the file unreadable.
+  bool moves_head = false;
+};
+
+/// The reader's state at one point of the file.
+struct GcodeState {
+  double e = 0;  ///< absolute E, mm
+  bool relative_e = false, relative_xyz = false;
+  double feed = kNoValue;  ///< the feed rate in force
+};
+
+/// The file's first retraction inside the print (length 0: none).
+struct GcodeRetraction {
+  double length = 0;         ///< mm of filament
+  double f = kNoValue;       ///< its feed rate
+  double back_f = kNoValue;  ///< the feed rate that gives it back
+};
+
+/// A whole G-code file as the one reader sees it. The views point into the text read, which
+/// must outlive the program.
+struct GcodeProgram {
+  std::vector<GcodeLine> lines;  ///< one per line of the file
+  std::vector<GcodeMove> moves;  ///< every G0/G1, in order
+  std::vector<GcodeProblem> problems;
+  /// The print: from its first ;LAYER_CHANGE line (lines.size() when there is none) up to
+  /// the ;TYPE:Custom after the last other ;TYPE: (PrusaSlicer's and OrcaSlicer's end G-code
+  /// follow one), else the end of the file. Line indices, 0-based.
+  std::size_t print_begin = 0, print_end = 0;
+  GcodeState at_print, at_end;    ///< when the print starts; when it ends
+  std::string_view fan_at_print;  ///< the start G-code's last M106/M107 line ("" when none)
+  /// Per layer of the print: its ;HEIGHT: (the planar thickness) and ;Z: (its top), mm.
+  std::vector<double> layer_height, layer_z;
+  GcodeRetraction retraction;
+  bool in_print(std::size_t line_index) const {
+    return line_index >= print_begin && line_index < print_end;
+  }
+};
+
+/// The one G-code reader, tolerant as a slicer's viewer is: PrusaSlicer's, OrcaSlicer's,
+/// Klipper's and our own files. Comments ;TYPE:, ;WIDTH:, ;HEIGHT:, ;Z:, ;LAYER_CHANGE,
+/// ;WIPE_START/END set what the moves carry; G90/G91, G92, M82/M83 are tracked (G91 makes E
+/// relative too, as Klipper, RepRapFirmware and PrusaSlicer's viewer read it). M-codes
+/// (dotted ones too: M862.3), T, Klipper macros (SET_PRINT_STATS_INFO, EXCLUDE_OBJECT_START:
+/// upper-case names, or lower-case ones with an underscore) and motionless G-codes pass as
+/// text. Never fails: what it cannot take (arcs, inches, unknown G-codes, junk, a bad number
+/// or unknown word in a move) is listed in `problems`, each with its line; home and probe
+/// (G28, G29) too, marked moves_head.
+GcodeProgram read_gcode_program(std::string_view text);
+
+/// One G0/G1 move with what it deposited (check's input).
+struct PrintMove {
+  Vec3 from{0, 0, 0}, to{0, 0, 0};
+  double filament = 0;     ///< mm of filament pushed (negative: retraction)
+  bool extruding = false;  ///< filament > 0 and the nozzle moved in XY
+  std::string type;        ///< the ;TYPE: in force ("" before any)
+  int layer = -1;          ///< ;LAYER_CHANGE count − 1
+  double width = 0.45;     ///< ;WIDTH: in force
+  int line = 0;            ///< 1-based line in the file (0 for moves made in memory)
+};
+
+/// The moves of a G-code file, through read_gcode_program. Refused (parse_error naming the
+/// line): any problem but home and probe (arcs, inches, unknown G-codes, junk).
+Expected<std::vector<PrintMove>> read_gcode_moves(std::string_view text);
+
+}  // namespace nonplanar

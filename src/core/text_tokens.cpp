@@ -1,0 +1,75 @@
+#include "core/text_tokens.hpp"
+
+#include <charconv>
+#include <cmath>
+
+namespace nonplanar::core {
+
+std::optional<double> parse_double(std::string_view t) {
+  if (t.empty()) return std::nullopt;
+  if (t.front() == '+') t.remove_prefix(1);  // from_chars rejects a leading '+'
+  double v = 0;
+  const auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
+  if (ec != std::errc() || end != t.data() + t.size() || !std::isfinite(v)) return std::nullopt;
+  return v;
+}
+
+std::optional<long long> parse_int(std::string_view t) {
+  if (t.empty()) return std::nullopt;
+  if (t.front() == '+') t.remove_prefix(1);
+  long long v = 0;
+  const auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
+  if (ec != std::errc() || end != t.data() + t.size()) return std::nullopt;
+  return v;
+}
+
+void Tokenizer::skip_space() {
+  while (pos_ < text_.size()) {
+    const char c = text_[pos_];
+    if (c == '\n') {
+      ++line_;
+    } else if (c == '\r') {
+      if (pos_ + 1 >= text_.size() || text_[pos_ + 1] != '\n') ++line_;  // lone CR
+    } else if (c != ' ' && c != '\t' && c != '\f' && c != '\v') {
+      break;
+    }
+    ++pos_;
+  }
+}
+
+std::string_view Tokenizer::next() {
+  skip_space();
+  const std::size_t start = pos_;
+  while (pos_ < text_.size()) {
+    const char c = text_[pos_];
+    if (c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\f' || c == '\v') break;
+    ++pos_;
+  }
+  return text_.substr(start, pos_ - start);
+}
+
+std::string_view Tokenizer::rest_of_line() {
+  const std::size_t start = pos_;
+  while (pos_ < text_.size() && text_[pos_] != '\n' && text_[pos_] != '\r') ++pos_;
+  return text_.substr(start, pos_ - start);
+}
+
+void Tokenizer::skip_line() {
+  rest_of_line();
+  if (pos_ < text_.size()) {
+    if (text_[pos_] == '\r' && pos_ + 1 < text_.size() && text_[pos_ + 1] == '\n') ++pos_;
+    ++pos_;
+    ++line_;
+  }
+}
+
+bool Tokenizer::at_end() {
+  skip_space();
+  return pos_ >= text_.size();
+}
+
+Error parse_error_at(int line, const std::string& msg) {
+  return Error{Status::parse_error, "line " + std::to_string(line) + ": " + msg};
+}
+
+}  // namespace nonplanar::core

@@ -1,0 +1,115 @@
+// clip_layer (layer_passes.hpp): a planar layer cut back to where a margin is >= 0 (the
+// shell's core under the shell). s is the parameter along a move, 0 at its start, 1 at its end.
+#include <algorithm>
+#include <cmath>
+#include <optional>
+
+#include "program/layer_passes.hpp"
+
+namespace nonplanar::program {
+namespace {
+
+// The pieces of the move from a to b (length len in XY) on either side of margin g(s) = 0:
+// cut parameters 0 = s_0 < … < s_n = 1 and, for each piece, whether it is kept.
+struct Pieces {
+  std::vector<double> cuts;
+  std::vector<char> kept;
+};
+
+template <class G>
+Pieces cut_move(const G& g, double len, int n) {
+  std::vector<double> cuts{0.0};
+  double s0 = 0, g0 = g(0);
+  for (int k = 1; k <= n; ++k) {
+    const double s1 = static_cast<double>(k) / n, g1 = g(s1);
+    if ((g0 >= 0) != (g1 >= 0)) {
+      double lo = s0, hi = s1;
+      for (int b = 0; b < 30; ++b) {
+        const double mid = 0.5 * (lo + hi);
+        ((g(mid) >= 0) == (g0 >= 0) ? lo : hi) = mid;
+      }
+      cuts.push_back(0.5 * (lo + hi));
+    }
+    s0 = s1, g0 = g1;
+  }
+  cuts.push_back(1.0);
+  // Neighbouring pieces on the same side are one, and a piece under 1 µm takes its
+  // neighbour's side: a margin of exactly 0 (a flat floor the core's boundaries were
+  // snapped to) flips back and forth within a step, or touches 0 at one point.
+  Pieces p;
+  p.cuts.push_back(0.0);
+  for (std::size_t k = 0; k + 1 < cuts.size(); ++k) {
+    const bool sliver = k > 0 && (cuts[k + 1] - cuts[k]) * len < 1e-3;
+    const char in = sliver ? p.kept.back() : g(0.5 * (cuts[k] + cuts[k + 1])) >= 0;
+    if (k > 0 && in != p.kept.back()) p.cuts.push_back(cuts[k]);
+    if (k == 0 || in != p.kept.back()) p.kept.push_back(in);
+  }
+  p.cuts.push_back(1.0);
+  return p;
+}
+
+}  // namespace
+
+int clip_layer(LayerWork& w, const std::function<double(double, double)>& margin,
+               const GcodeRetraction& ret, std::size_t& samples) {
+  std::vector<GcodeLine> out;
+  out.reserve(w.lines.size());
+  // The give-back of a retraction around cut-away travel: held while the travel goes on (the
+  // next extrusion cut away too, as a whole perimeter above the core often is), added before
+  // anything else.
+  std::optional<GcodeMove> owed;
+  auto settle = [&] {
+    if (owed) out.push_back(w.add(*owed)), owed.reset();
+  };
+  for (const GcodeLine& it : w.lines) {
+    if (it.kind != GcodeLine::Kind::move ||
+        !w.moves[static_cast<std::size_t>(it.move)].extruding()) {
+      settle();
+      out.push_back(it);
+      continue;
+    }
+    const GcodeMove m = w.moves[static_cast<std::size_t>(it.move)];
+    auto at = [&](double s) { return Vec3(m.from + s * (m.to - m.from)); };
+    auto g = [&](double s) {
+      const Vec3 p = at(s);
+      return margin(p.x(), p.y());
+    };
+    const double len = (m.to - m.from).head<2>().norm();
+    const int n = std::max(1, static_cast<int>(std::ceil(len / 0.05)));
+    samples += static_cast<std::size_t>(n) + 1;
+    if (samples > 50'000'000) return m.line;
+    const Pieces pieces = cut_move(g, len, n);
+    const std::vector<double>& cuts = pieces.cuts;
+    if (cuts.size() == 2 && pieces.kept[0]) {
+      out.push_back(it);
+      continue;
+    }
+    for (std::size_t k = 0; k + 1 < cuts.size(); ++k) {
+      GcodeMove piece = m;
+      piece.from = at(cuts[k]), piece.to = at(cuts[k + 1]);
+      piece.f = k == 0 ? m.f : kNoValue;
+      if (pieces.kept[k]) {
+        if (owed) settle(), piece.f = m.feed;  // after the give-back's feed rate
+        piece.de = m.de * (cuts[k + 1] - cuts[k]);
+        out.push_back(w.add(piece));
+        continue;
+      }
+      piece.de = 0, piece.has_e = false;
+      const bool hop = ret.length > 0 && (owed || (piece.to - piece.from).head<2>().norm() > 2.0);
+      GcodeMove r = piece;
+      r.has_xy = false, r.has_e = true;
+      if (hop && !owed) {
+        r.to = r.from, r.de = -ret.length, r.f = ret.f;
+        out.push_back(w.add(r));
+      }
+      if (hop) piece.f = m.feed;
+      out.push_back(w.add(piece));
+      if (hop) r.from = r.to = piece.to, r.de = ret.length, r.f = ret.back_f, owed = r;
+    }
+  }
+  settle();
+  w.lines = std::move(out);
+  return 0;
+}
+
+}  // namespace nonplanar::program

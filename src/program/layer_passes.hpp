@@ -1,0 +1,42 @@
+// Passes over one layer of a program being mapped onto curved layers, written once for every
+// route that maps G-code (another slicer's file, the shell's two runs, a post-processed file).
+#pragma once
+
+#include <cstddef>
+#include <functional>
+#include <vector>
+
+#include "nonplanar/program.hpp"
+#include "nonplanar/toolpaths.hpp"
+
+namespace nonplanar::program {
+
+/// One layer at work: its lines in order, the program's moves, and each move's path on its
+/// curved layer (`mapped[i]` for `moves[i]`; empty for travels and retractions). Passes
+/// append the moves they make (with a path, or none) and rewrite `lines`.
+struct LayerWork {
+  std::vector<GcodeLine>& lines;
+  std::vector<GcodeMove>& moves;
+  std::vector<ExtrusionPath>& mapped;
+  /// Appends m (mapped as p) and returns the line that prints it.
+  GcodeLine add(GcodeMove m, ExtrusionPath p = {});
+};
+
+/// Top skins on a slope, low to high (DESIGN.md §3: a line printed beside a higher line of
+/// the same layer drags the nozzle's flat through it). In each run of "Top solid infill" the
+/// strokes (unbroken extrusions) are sorted by mean mapped height and each starts at its low
+/// end; the travels between them are made anew, with the run's own retraction around them
+/// (travels over 1 mm) and its extrusion feed rate after. The run's trailing wipes become
+/// plain retractions (their path retraced the old last stroke). Needs `mapped` filled.
+void order_top_skins(LayerWork& layer);
+
+/// Cuts each extrusion of the layer to where margin(x, y) >= 0 (a continuous function, mm):
+/// kept pieces extrude their share of E, the rest become travels, retracted around (`ret`,
+/// the file's own retraction) when longer than 2 mm, as PrusaSlicer's retract_before_travel
+/// does. Crossings are found on 0.05 mm steps and bisected. `samples` counts the margins
+/// looked up; past 50 million (a broken file, not a print) it stops and returns the line it
+/// was on (else 0). Runs before mapping: `mapped` entries of new moves are empty.
+int clip_layer(LayerWork& layer, const std::function<double(double x, double y)>& margin,
+               const GcodeRetraction& ret, std::size_t& samples);
+
+}  // namespace nonplanar::program

@@ -1,0 +1,289 @@
+// The one G-code reader (program.hpp): every line classified, every move with what it carries,
+// problems listed with their lines instead of failing, so each caller decides what it refuses
+// (check: anything unreadable; the mapping of another slicer's file: anything inside the print).
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+
+#include "core/text_tokens.hpp"
+#include "nonplanar/program.hpp"
+
+namespace nonplanar {
+namespace {
+
+using Kind = GcodeLine::Kind;
+
+char upper(char c) {
+  return static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+}
+
+// A Klipper-style extended command: SET_PRINT_STATS_INFO, EXCLUDE_OBJECT_START, PRINT_START,
+// or a lower-case name with an underscore (Klipper upper-cases commands itself). A word that
+// is neither (random text) is not a command.
+bool is_macro(std::string_view w) {
+  if (w.size() < 2 || !std::isalpha(static_cast<unsigned char>(w[0]))) return false;
+  // "G1X10" is a malformed G-code, not a macro's name.
+  const char k = upper(w[0]);
+  if ((k == 'G' || k == 'M') && std::isdigit(static_cast<unsigned char>(w[1]))) return false;
+  bool upper_case = true, underscore = false;
+  for (const char c : w) {
+    const auto b = static_cast<unsigned char>(c);
+    if (!std::isalnum(b) && c != '_') return false;
+    if (std::islower(b)) upper_case = false;
+    if (c == '_') underscore = true;
+  }
+  return upper_case || underscore;
+}
+
+// An M-code number: digits, optionally dotted (M862.3).
+bool is_m_number(std::string_view n) {
+  const std::size_t dot = n.find('.');
+  auto digits = [](std::string_view s) {
+    return !s.empty() && std::all_of(s.begin(), s.end(), [](char c) {
+      return std::isdigit(static_cast<unsigned char>(c));
+    });
+  };
+  return dot == std::string_view::npos ? digits(n)
+                                       : digits(n.substr(0, dot)) && digits(n.substr(dot + 1));
+}
+
+class Reader {
+ public:
+  explicit Reader(GcodeProgram& p) : p_(p) {}
+  void split(std::string_view text);
+  void find_print();
+  void read_line(std::size_t i);
+
+ private:
+  void comment(std::string_view c, std::size_t semi, GcodeLine& item, bool in_print);
+  void command(std::string_view cmd, core::Tokenizer& tok, GcodeLine& item, std::size_t i);
+  void set_position(core::Tokenizer& tok, GcodeLine& item);
+  void move(core::Tokenizer& tok, GcodeLine& item, bool in_print);
+  void problem(std::string why, bool moves_head = false) {
+    p_.problems.push_back({line_, std::move(why), moves_head});
+  }
+
+  GcodeProgram& p_;
+  int line_ = 0;
+  Vec3 pos_{0, 0, 0};
+  GcodeState s_;
+  double width_ = 0.45, h_ = 0.2;
+  bool wipe_ = false, layer_header_ = false;  // layer_header: ;LAYER_CHANGE seen, not ;HEIGHT:
+  std::string_view type_;
+  int layer_ = -1;
+};
+
+void Reader::split(std::string_view text) {
+  for (std::size_t start = 0; start < text.size();) {
+    std::size_t end = text.find('\n', start);
+    if (end == std::string_view::npos) end = text.size();
+    std::string_view l = text.substr(start, end - start);
+    if (!l.empty() && l.back() == '\r') l.remove_suffix(1);
+    GcodeLine item;
+    item.raw = l;
+    p_.lines.push_back(item);
+    start = end + 1;
+  }
+}
+
+void Reader::find_print() {
+  const std::size_t n = p_.lines.size();
+  std::size_t last_typed = 0;
+  p_.print_begin = p_.print_end = n;
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::string_view l = p_.lines[i].raw;
+    if (p_.print_begin == n && l.rfind(";LAYER_CHANGE", 0) == 0) p_.print_begin = i;
+    if (l.rfind(";TYPE:", 0) == 0 && l.rfind(";TYPE:Custom", 0) != 0) last_typed = i;
+  }
+  if (p_.print_begin == n) return;
+  for (std::size_t i = std::max(last_typed, p_.print_begin); i < n; ++i)
+    if (p_.lines[i].raw.rfind(";TYPE:Custom", 0) == 0) {
+      p_.print_end = i;
+      break;
+    }
+}
+
+void Reader::read_line(std::size_t i) {
+  line_ = static_cast<int>(i) + 1;
+  const bool in_print = p_.in_print(i);
+  if (i == p_.print_begin) p_.at_print = s_;
+  if (i == p_.print_end) p_.at_end = s_;
+  GcodeLine& item = p_.lines[i];
+  std::string_view l = item.raw;
+  const std::size_t semi = l.find(';');
+  if (semi != std::string_view::npos) {
+    comment(l.substr(semi), semi, item, in_print);
+    l = l.substr(0, semi);
+  }
+  item.layer = layer_;
+  core::Tokenizer tok(l);
+  const std::string_view cmd = tok.next();
+  if (!cmd.empty()) command(cmd, tok, item, i);
+  if (i + 1 == p_.lines.size() && p_.print_end == p_.lines.size()) p_.at_end = s_;
+}
+
+void Reader::comment(std::string_view c, std::size_t semi, GcodeLine& item, bool in_print) {
+  if (c.rfind(";TYPE:", 0) == 0) type_ = c.substr(6);
+  if (c.rfind(";WIDTH:", 0) == 0)
+    if (auto w = core::parse_double(c.substr(7)); w && *w > 0) width_ = *w;
+  if (c.rfind(";WIPE_START", 0) == 0) wipe_ = true;
+  if (c.rfind(";WIPE_END", 0) == 0) wipe_ = false;
+  if (!in_print) return;
+  if (c.rfind(";LAYER_CHANGE", 0) == 0) {
+    ++layer_;
+    p_.layer_height.push_back(h_);
+    p_.layer_z.push_back(pos_.z() + h_);
+    layer_header_ = true;
+  }
+  // The layer's thickness is the ;HEIGHT: of its header; later ones are a bead's (a bridge's
+  // is the nozzle's diameter) and pass untouched.
+  if (layer_header_ && semi == 0 && c.rfind(";HEIGHT:", 0) == 0) {
+    if (auto v = core::parse_double(c.substr(8)); v && *v > 0) h_ = *v, p_.layer_height.back() = h_;
+    item.kind = Kind::height_comment;
+    layer_header_ = false;
+  }
+  if (semi == 0 && c.rfind(";Z:", 0) == 0) {
+    item.kind = Kind::z_comment;
+    if (auto v = core::parse_double(c.substr(3)); v && layer_ >= 0)
+      p_.layer_z[static_cast<std::size_t>(layer_)] = *v;
+  }
+}
+
+void Reader::command(std::string_view cmd, core::Tokenizer& tok, GcodeLine& item, std::size_t i) {
+  const char kind = upper(cmd[0]);
+  if (kind == 'T') return;  // tool change: passes
+  if (kind == 'M' && is_m_number(cmd.substr(1))) {
+    const auto num = core::parse_int(cmd.substr(1));
+    if (num && (*num == 82 || *num == 83)) {
+      s_.relative_e = *num == 83;
+      item.kind = Kind::e_mode, item.value = s_.relative_e;
+    }
+    if (num && (*num == 106 || *num == 107) && i < p_.print_begin) p_.fan_at_print = item.raw;
+    return;
+  }
+  const auto num = kind == 'G' ? core::parse_int(cmd.substr(1)) : std::nullopt;
+  if (!num) {
+    if (!is_macro(cmd)) problem("'" + std::string(cmd.substr(0, 20)) + "' is not a G-code command");
+    return;
+  }
+  switch (*num) {
+    case 0:
+    case 1:
+      return move(tok, item, p_.in_print(i));
+    case 92:
+      return set_position(tok, item);
+    case 90:
+    case 91:
+      s_.relative_xyz = *num == 91;
+      if (s_.relative_xyz) item.kind = Kind::xyz_relative;
+      return;
+    case 2:
+    case 3:
+      return problem(
+          "arc move (G2/G3): arcs cannot be measured or mapped onto curved layers; "
+          "turn arc fitting off");
+    case 20:
+      return problem("inch units (G20) are not supported");
+    case 28:
+    case 29:
+      return problem("'" + std::string(cmd) +
+                         "' (home or probe) inside the print cannot be "
+                         "mapped onto curved layers",
+                     true);
+    case 4:
+    case 10:
+    case 11:
+    case 17:
+    case 21:
+    case 80:
+    case 94:
+      return;
+    default:
+      return problem("unknown G-code G" + std::to_string(*num));
+  }
+}
+
+void Reader::set_position(core::Tokenizer& tok, GcodeLine& item) {
+  for (std::string_view w = tok.next(); !w.empty(); w = tok.next()) {
+    const auto v = core::parse_double(w.substr(1));
+    if (!v) {
+      problem("bad number in G92");
+      continue;
+    }
+    const char a = upper(w[0]);
+    if (a == 'E') s_.e = *v, item.kind = Kind::e_reset, item.value = *v;
+    if (a == 'X') pos_.x() = *v;
+    if (a == 'Y') pos_.y() = *v;
+    if (a == 'Z') pos_.z() = *v;
+  }
+}
+
+void Reader::move(core::Tokenizer& tok, GcodeLine& item, bool in_print) {
+  GcodeMove m;
+  m.line = line_, m.from = pos_, m.to = pos_;
+  for (std::string_view w = tok.next(); !w.empty(); w = tok.next()) {
+    const char a = upper(w[0]);
+    const auto v = core::parse_double(w.substr(1));
+    if (!v) {
+      problem("bad number in '" + std::string(w.substr(0, 30)) + "'");
+      continue;
+    }
+    const bool rel = s_.relative_xyz;
+    if (a == 'X')
+      m.to.x() = rel ? m.to.x() + *v : *v, m.has_xy = true;
+    else if (a == 'Y')
+      m.to.y() = rel ? m.to.y() + *v : *v, m.has_xy = true;
+    else if (a == 'Z')
+      m.to.z() = rel ? m.to.z() + *v : *v, m.has_z = true;
+    else if (a == 'E')
+      // G91 makes E relative too, as M83 does (Klipper, RepRapFirmware, Marlin 1 and
+      // PrusaSlicer's viewer; read as absolute, a G91 retraction became 75x extrusion).
+      m.has_e = true, m.de = s_.relative_e || rel ? *v : *v - s_.e,
+      s_.e = s_.relative_e || rel ? s_.e + *v : *v;
+    else if (a == 'F')
+      m.f = *v;
+    else
+      problem("unknown word '" + std::string(w.substr(0, 20)) + "' in a move");
+  }
+  pos_ = m.to;
+  if (!std::isnan(m.f)) s_.feed = m.f;
+  m.feed = s_.feed;
+  if (in_print && !m.has_xy && !m.has_z && m.has_e) {
+    GcodeRetraction& r = p_.retraction;
+    if (m.de < 0 && r.length == 0) r.length = -m.de, r.f = m.f;
+    if (m.de > 0 && std::isnan(r.back_f)) r.back_f = m.f;
+  }
+  m.wipe = wipe_, m.type = type_, m.width = width_, m.height = h_, m.layer = layer_;
+  item.kind = Kind::move;
+  item.move = static_cast<int>(p_.moves.size());
+  p_.moves.push_back(m);
+}
+
+}  // namespace
+
+GcodeProgram read_gcode_program(std::string_view text) {
+  GcodeProgram p;
+  Reader r(p);
+  r.split(text);
+  r.find_print();
+  for (std::size_t i = 0; i < p.lines.size(); ++i) r.read_line(i);
+  return p;
+}
+
+Expected<std::vector<PrintMove>> read_gcode_moves(std::string_view text) {
+  const GcodeProgram p = read_gcode_program(text);
+  for (const GcodeProblem& q : p.problems)
+    if (!q.moves_head)
+      return Error{Status::parse_error, "line " + std::to_string(q.line) + ": " + q.why};
+  std::vector<PrintMove> moves;
+  moves.reserve(p.moves.size());
+  for (const GcodeMove& g : p.moves) {
+    PrintMove m;
+    m.from = g.from, m.to = g.to, m.filament = g.de, m.extruding = g.extruding();
+    m.type = std::string(g.type), m.layer = g.layer, m.width = g.width, m.line = g.line;
+    moves.push_back(std::move(m));
+  }
+  return moves;
+}
+
+}  // namespace nonplanar

@@ -1,0 +1,169 @@
+// The one G-code reader and the one emitter (src/program/): what each line is, what each
+// move carries, what is a problem and where; the emitter's formats and E bookkeeping.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+#include "nonplanar/deform.hpp"
+#include "nonplanar/program.hpp"
+#include "program/gcode_text.hpp"
+
+namespace nonplanar {
+namespace {
+
+using Kind = GcodeLine::Kind;
+
+// The start of a stock Original Prusa MK3S file (PrusaSlicer 2.5), a Klipper print's object
+// labels, and an end G-code after ;TYPE:Custom.
+const std::string kPrusaStart =
+    "M73 P0 R12\n"
+    "M862.3 P \"MK3S\" ; printer model check\n"
+    "M862.1 P0.4 ; nozzle diameter check\n"
+    "M115 U3.13.2 ; tell printer latest fw version\n"
+    "G90 ; use absolute coordinates\n"
+    "M83 ; extruder relative mode\n"
+    "G28 W ; home all without mesh bed level\n"
+    "G80 ; mesh bed leveling\n"
+    "G1 Y-3.0 F1000.0 ; go outside print area\n"
+    "G1 X60.0 E9.0 F1000.0 ; intro line\n"
+    "M221 S95\n"
+    "M900 K0.04 ; Filament gcode LA 1.5\n"
+    "M107\n";
+const std::string kPrint =
+    ";LAYER_CHANGE\n"
+    ";Z:0.2\n"
+    ";HEIGHT:0.2\n"
+    "EXCLUDE_OBJECT_START NAME=cube_id_0_copy_0\n"
+    "SET_PRINT_STATS_INFO CURRENT_LAYER=1\n"
+    "G1 E-0.8 F2100\n"
+    "G1 Z0.2 F720\n"
+    "G1 X10 Y10 F7200\n"
+    "G1 E0.8 F2100\n"
+    ";TYPE:External perimeter\n"
+    ";WIDTH:0.42\n"
+    "G1 F1200\n"
+    "G1 X20 Y10 E0.5\n"
+    "G1 X20 Y20 E0.5\n"
+    "M73 P50 R6\n"
+    "EXCLUDE_OBJECT_END NAME=cube_id_0_copy_0\n"
+    ";LAYER_CHANGE\n"
+    ";Z:0.4\n"
+    ";HEIGHT:0.2\n"
+    "G1 Z0.4 F720\n"
+    ";TYPE:Top solid infill\n"
+    "G1 X10 Y20 E0.5\n"
+    "print_layer_done\n";
+const std::string kEnd =
+    ";TYPE:Custom\n"
+    "G1 Z30.4 F720 ; Move print head up\n"
+    "G1 X0 Y200 F3600 ; park\n"
+    "M84 ; disable motors\n";
+
+TEST(ReadProgram, StockPrusaAndKlipperLinesPassAsText) {
+  const std::string text = kPrusaStart + kPrint + kEnd;
+  const GcodeProgram p = read_gcode_program(text);
+  ASSERT_EQ(p.problems.size(), 1u);  // G28 W: home, fine outside the print
+  EXPECT_TRUE(p.problems[0].moves_head);
+  EXPECT_EQ(p.problems[0].line, 7);
+  EXPECT_EQ(p.lines.size(), 40u);
+  EXPECT_EQ(p.print_begin, 13u);            // the first ;LAYER_CHANGE
+  EXPECT_EQ(p.print_end, 36u);              // the ;TYPE:Custom after the last typed extrusion
+  EXPECT_EQ(p.lines[1].kind, Kind::text);   // M862.3
+  EXPECT_EQ(p.lines[16].kind, Kind::text);  // EXCLUDE_OBJECT_START
+  EXPECT_EQ(p.lines[5].kind, Kind::e_mode);
+  EXPECT_EQ(p.lines[14].kind, Kind::z_comment);
+  EXPECT_EQ(p.lines[15].kind, Kind::height_comment);
+  EXPECT_EQ(p.fan_at_print, "M107");
+  EXPECT_TRUE(p.at_print.relative_e);
+  ASSERT_EQ(p.layer_z.size(), 2u);
+  EXPECT_DOUBLE_EQ(p.layer_z[1], 0.4);
+  EXPECT_NEAR(p.retraction.length, 0.8, 1e-12);
+  EXPECT_NEAR(p.retraction.f, 2100, 1e-12);
+  // Moves: every G0/G1, with the type, width and layer in force, and the feed rate.
+  ASSERT_EQ(p.moves.size(), 13u);
+  const GcodeMove& m = p.moves[7];  // G1 X20 Y10 E0.5
+  EXPECT_EQ(m.line, 26);
+  EXPECT_TRUE(m.extruding());
+  EXPECT_NEAR(m.de, 0.5, 1e-12);
+  EXPECT_EQ(m.type, "External perimeter");
+  EXPECT_NEAR(m.width, 0.42, 1e-12);
+  EXPECT_EQ(m.layer, 0);
+  EXPECT_NEAR(m.feed, 1200, 1e-12);
+  EXPECT_TRUE(std::isnan(m.f));
+  EXPECT_EQ(p.moves[10].layer, 1);
+  EXPECT_EQ(p.moves[10].type, "Top solid infill");
+  // check reads it (home is no reason to refuse a file), and so does the mapping.
+  auto moves = read_gcode_moves(text);
+  ASSERT_TRUE(moves) << moves.error().message;
+  EXPECT_EQ(moves->size(), 13u);
+  const auto field = planar_field({});
+  auto mapped = map_foreign_gcode(text, *field, {}, {});
+  ASSERT_TRUE(mapped) << mapped.error().message;
+  EXPECT_NE(mapped->text.find("EXCLUDE_OBJECT_START NAME=cube_id_0_copy_0\n"), std::string::npos);
+  EXPECT_NE(mapped->text.find("M862.3 P \"MK3S\""), std::string::npos);
+  EXPECT_NE(mapped->text.find("\nprint_layer_done\n"), std::string::npos);
+}
+
+TEST(ReadProgram, ProblemsNameTheirLines) {
+  const GcodeProgram p = read_gcode_program(
+      "G1 X1 Y1\nhello world\nG2 X5 Y5 I1 J1\nG1 X2 Q4\nG20\nG5\nG1X10Y10\nG1 Xnan\nG29\n");
+  ASSERT_EQ(p.problems.size(), 8u);
+  for (std::size_t k = 0; k < p.problems.size(); ++k)
+    EXPECT_EQ(p.problems[k].line, static_cast<int>(k) + 2) << p.problems[k].why;
+  EXPECT_NE(p.problems[1].why.find("arc"), std::string::npos);
+  EXPECT_NE(p.problems[2].why.find("'Q4'"), std::string::npos);
+  EXPECT_TRUE(p.problems[7].moves_head);
+  EXPECT_FALSE(p.problems[0].moves_head);
+  // The move with a bad word is still read, without the word.
+  EXPECT_EQ(p.moves.size(), 3u);
+  EXPECT_NEAR(p.moves[1].to.x(), 2, 1e-12);
+  // Inside the print, the mapping refuses home and probe and macros pass.
+  const auto field = planar_field({});
+  const std::string head = ";LAYER_CHANGE\n;Z:0.2\n;HEIGHT:0.2\nG1 X1 Y1 E1\n";
+  EXPECT_TRUE(map_foreign_gcode(head + "BED_MESH_CALIBRATE\n", *field, {}, {}));
+  auto home = map_foreign_gcode(head + "G28\n", *field, {}, {});
+  ASSERT_FALSE(home);
+  EXPECT_NE(home.error().message.find("line 5: 'G28' (home or probe)"), std::string::npos)
+      << home.error().message;
+}
+
+TEST(ReadProgram, RelativeAxesAndResets) {
+  const GcodeProgram p =
+      read_gcode_program("G92 E5\nG1 X1 Y0 E6\nG91\nG1 X1 E0.5\nG90\nM83\nG1 X0 E0.25\n");
+  ASSERT_EQ(p.moves.size(), 3u);
+  EXPECT_NEAR(p.moves[0].de, 1, 1e-12);  // absolute: 6 − 5
+  EXPECT_NEAR(p.moves[1].to.x(), 2, 1e-12);
+  EXPECT_NEAR(p.moves[1].de, 0.5, 1e-12);  // G91 makes E relative too
+  EXPECT_NEAR(p.moves[2].de, 0.25, 1e-12);
+  EXPECT_EQ(p.lines[0].kind, Kind::e_reset);
+  EXPECT_EQ(p.lines[2].kind, Kind::xyz_relative);
+  EXPECT_NEAR(p.at_end.e, 6.75, 1e-12);
+  EXPECT_TRUE(p.at_end.relative_e);
+}
+
+TEST(GcodeText, WritesTheWordsAskedForAndKeepsE) {
+  program::GcodeText abs(false, 1.0);
+  program::MoveWords w;
+  w.xy = true, w.de = 0.5, w.f = 1799.6;
+  abs.move(Vec3(1.23456, 2, 0.2), w);
+  w.xy = false, w.z = true, w.de = -0.8, w.f = kNoValue, w.comment = "retract";
+  abs.move(Vec3(1, 2, 0.3), w);
+  EXPECT_EQ(abs.out, "G1 X1.235 Y2.000 E1.50000 F1800\nG1 Z0.300 E0.70000 ; retract\n");
+  program::GcodeText rel(true);
+  rel.move_from(Vec3(0, 0, 0.2), Vec3(0.0004, 0, 0.2), 0.1, kNoValue);  // under 0.5 µm: no XY
+  rel.move_from(Vec3(0, 0, 0.2), Vec3(0, 0, 0.2), kNoValue, kNoValue);  // nothing to write
+  rel.move_from(Vec3(0, 0, 0.2), Vec3(3, 0, 0.2), 0.2, kNoValue);
+  EXPECT_EQ(rel.out, "G1 E0.10000\nG1 X3.000 Y0.000 E0.20000\n");
+  EXPECT_FALSE(rel.fault);
+  // A number no printer takes does not fit a line: the program is refused, not truncated.
+  w.z = false, w.xy = true, w.de = 1e300, w.comment = nullptr;
+  rel.move(Vec3(1, 1, 1), w);
+  ASSERT_TRUE(rel.fault);
+  program::GcodeText lift;
+  program::lifted_travel(lift, Vec3(0, 0, 1), Vec3(5, 0, 1.2), 1.6, 9000, kNoValue);
+  EXPECT_EQ(lift.out, "G1 Z1.600 F9000\nG1 X5.000 Y0.000\nG1 Z1.200\n");
+}
+
+}  // namespace
+}  // namespace nonplanar
