@@ -8,7 +8,7 @@
 #include <cmath>
 #include <random>
 
-#include "nonplanar/fit.hpp"
+#include "nonplanar/patch_fit.hpp"
 
 namespace {
 

@@ -6,7 +6,7 @@
 
 #include "cli_common.hpp"
 #include "commands.hpp"
-#include "io/mesh_buffer.hpp"
+#include "core/file_bytes.hpp"
 #include "nonplanar/check.hpp"
 
 namespace nonplanar::cli {
@@ -26,7 +26,7 @@ int run(const CheckOptions& o) {
   if (auto a = check_max_angle(o.max_angle); !a) return report_error(a.error());
   const CheckParams params = check_params(*cfg, o.max_angle);
   Context ctx = make_context(o.mesh.quiet || o.json);
-  auto bytes = io::read_file_bytes(o.gcode, 2ull << 30);
+  auto bytes = core::read_file_bytes(o.gcode, 2ull << 30);
   if (!bytes)
     return finish_progress(),
            report_error({bytes.error().status, o.gcode + ": " + bytes.error().message});

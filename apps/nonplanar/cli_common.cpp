@@ -14,7 +14,7 @@
 
 #include "core/atomic_file.hpp"
 #include "core/sanitizers.hpp"
-#include "slice/external_engine.hpp"
+#include "engine/external_engine.hpp"
 
 namespace nonplanar::cli {
 namespace {

@@ -7,7 +7,7 @@
 
 #include "cli_common.hpp"
 #include "commands.hpp"
-#include "nonplanar/fit.hpp"
+#include "nonplanar/patch_fit.hpp"
 #include "nonplanar/surface_io.hpp"
 
 namespace nonplanar::cli {

@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "nonplanar/analysis.hpp"
-#include "nonplanar/fit.hpp"
+#include "nonplanar/patch_fit.hpp"
 #include "nonplanar/toolhead.hpp"
 
 namespace nonplanar {

@@ -8,21 +8,10 @@
 
 #include "nonplanar/check.hpp"
 #include "nonplanar/deform.hpp"
+#include "nonplanar/engine.hpp"
 #include "nonplanar/layers.hpp"
 
 namespace nonplanar {
-
-/// The planar engine that slices the (normalised) mesh.
-enum class Engine { builtin, prusaslicer, orcaslicer };
-
-struct EngineParams {
-  Engine engine = Engine::builtin;
-  std::string path;       ///< its executable; empty: prusa-slicer / orca-slicer on PATH
-  std::string config;     ///< PrusaSlicer: a profile .ini (--load); OrcaSlicer: --load-settings
-  std::string filaments;  ///< OrcaSlicer: --load-filaments
-  /// Settings the user overrode (PrusaSlicer keys and values), passed on to PrusaSlicer.
-  std::vector<std::pair<std::string, std::string>> overrides;
-};
 
 struct SliceJob {
   AnalysisParams analysis;

@@ -5,16 +5,9 @@
 
 #include "nonplanar/config.hpp"
 #include "nonplanar/context.hpp"
+#include "nonplanar/polygon.hpp"
 
 namespace nonplanar {
-
-/// A closed polygon in XY (mm); contours counter-clockwise, holes clockwise.
-using Polygon = std::vector<Vec2>;
-
-struct ExPolygon {
-  Polygon contour;
-  std::vector<Polygon> holes;
-};
 
 struct SlicedLayer {
   double z_bottom = 0, z_top = 0;  ///< the layer's span, mm
@@ -37,8 +30,5 @@ Expected<std::vector<SlicedLayer>> slice_mesh(const TriangleMesh& mesh, const Sl
 Expected<std::vector<SlicedLayer>> slice_mesh_at(const TriangleMesh& mesh,
                                                  std::vector<SlicedLayer> layers,
                                                  const Context& ctx);
-
-/// Area of polygons with holes, mm².
-double area(const std::vector<ExPolygon>& polys);
 
 }  // namespace nonplanar

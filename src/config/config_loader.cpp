@@ -3,7 +3,7 @@
 #include <cmath>
 #include <nlohmann/json.hpp>
 
-#include "io/mesh_buffer.hpp"
+#include "core/file_bytes.hpp"
 #include "nonplanar/config.hpp"
 
 namespace nonplanar {
@@ -32,7 +32,7 @@ Expected<PrintConfig> parse_json_config(std::string_view text, PrintConfig c) {
 }
 
 Expected<PrintConfig> load_config(const std::filesystem::path& file, PrintConfig base) {
-  auto bytes = io::read_file_bytes(file, 64u << 20);
+  auto bytes = core::read_file_bytes(file, 64u << 20);
   if (!bytes) return Error{bytes.error().status, file.string() + ": " + bytes.error().message};
   std::string ext = file.extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(),

@@ -6,7 +6,7 @@
 #include <sstream>
 #include <tuple>
 
-#include "io/mesh_buffer.hpp"
+#include "core/text_tokens.hpp"
 #include "nonplanar/config.hpp"
 
 namespace nonplanar {
@@ -26,17 +26,17 @@ std::string first_item(const std::string& v) {
 }
 
 std::optional<double> number(const std::string& v) {
-  return io::parse_double(first_item(v));
+  return core::parse_double(first_item(v));
 }
 
 // "45" or "50%" (of `base`).
 std::optional<double> number_or_percent(const std::string& v, double base) {
   std::string s = first_item(v);
   if (!s.empty() && s.back() == '%') {
-    const auto d = io::parse_double(s.substr(0, s.size() - 1));
+    const auto d = core::parse_double(s.substr(0, s.size() - 1));
     return d ? std::optional<double>(*d / 100.0 * base) : std::nullopt;
   }
-  return io::parse_double(s);
+  return core::parse_double(s);
 }
 
 // PrusaSlicer stores G-code templates with \n escapes.
@@ -226,9 +226,9 @@ Expected<bool> set_value(PrintConfig& c, const std::string& key, const std::stri
     while (std::getline(ss, item, ',')) {
       const auto x = item.find('x');
       const auto a =
-          x == std::string::npos ? std::nullopt : io::parse_double(first_item(item.substr(0, x)));
+          x == std::string::npos ? std::nullopt : core::parse_double(first_item(item.substr(0, x)));
       const auto b =
-          x == std::string::npos ? std::nullopt : io::parse_double(first_item(item.substr(x + 1)));
+          x == std::string::npos ? std::nullopt : core::parse_double(first_item(item.substr(x + 1)));
       if (!a || !b) return bad(key, "'" + item + "' is not XxY");
       lo = lo.cwiseMin(Vec2(*a, *b));
       hi = hi.cwiseMax(Vec2(*a, *b));

@@ -5,7 +5,8 @@
 #include <optional>
 #include <sstream>
 
-#include "io/mesh_buffer.hpp"
+#include "core/file_bytes.hpp"
+#include "core/text_tokens.hpp"
 #include "nonplanar/config.hpp"
 
 #ifndef NONPLANAR_TOOLHEADS_DIR
@@ -31,7 +32,7 @@ Expected<std::vector<Vec2>> parse_polygon(const nlohmann::json& j, const std::st
     std::istringstream in(s);
     std::string word;
     while (in >> word) {
-      const auto v = io::parse_double(word);
+      const auto v = core::parse_double(word);
       if (!v) return bad(where + ": '" + word.substr(0, 20) + "' is not a number");
       xy.push_back(*v);
     }
@@ -88,7 +89,7 @@ Expected<std::vector<ToolheadSlice>> parse_toolhead_shape(std::string_view text)
     // PrusaSlicer writes heights as strings ("11").
     std::optional<double> height;
     if (h.is_number()) height = h.get<double>();
-    if (h.is_string()) height = io::parse_double(h.get<std::string>());
+    if (h.is_string()) height = core::parse_double(h.get<std::string>());
     if (!height || !std::isfinite(*height) || *height < 0 || *height > kMaxSize)
       return bad(where + ": \"height\" must be a number of mm from 0 to 1000");
     slice.height = *height;
@@ -113,7 +114,7 @@ Expected<std::vector<ToolheadSlice>> load_toolhead_shape(const std::string& file
   const bool bare = file_or_name.find('/') == std::string::npos && !file.has_extension();
   if (bare && !std::filesystem::exists(file, ec))
     file = std::filesystem::path(NONPLANAR_TOOLHEADS_DIR) / (file_or_name + ".json");
-  auto bytes = io::read_file_bytes(file, 4u << 20);
+  auto bytes = core::read_file_bytes(file, 4u << 20);
   if (!bytes) {
     std::string why = bytes.error().message;
     if (bare) why += " (not a file, nor a head in " NONPLANAR_TOOLHEADS_DIR ")";

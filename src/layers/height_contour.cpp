@@ -10,7 +10,7 @@
 #include <limits>
 #include <unordered_map>
 
-#include "slice/polygon_ops.hpp"
+#include "core/polygon_ops.hpp"
 
 namespace nonplanar::layers {
 

@@ -5,7 +5,7 @@
 #include <vector>
 
 #include "layers/faceted_top.hpp"
-#include "nonplanar/slice.hpp"
+#include "nonplanar/polygon.hpp"
 
 namespace nonplanar::layers {
 

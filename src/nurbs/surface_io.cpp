@@ -6,7 +6,7 @@
 #include <ostream>
 
 #include "core/atomic_file.hpp"
-#include "io/mesh_buffer.hpp"
+#include "core/file_bytes.hpp"
 
 namespace nonplanar {
 
@@ -127,7 +127,7 @@ Expected<std::vector<SurfaceRecord>> parse_surfaces_json(std::string_view text) 
 }
 
 Expected<std::vector<SurfaceRecord>> read_surfaces_json(const std::filesystem::path& file) {
-  auto bytes = io::read_file_bytes(file, 1u << 30);
+  auto bytes = core::read_file_bytes(file, 1u << 30);
   if (!bytes) return Error{bytes.error().status, file.string() + ": " + bytes.error().message};
   auto r = parse_surfaces_json(bytes->view());
   if (!r) return Error{r.error().status, file.string() + ": " + r.error().message};

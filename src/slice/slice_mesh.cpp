@@ -7,7 +7,8 @@
 #include <cstdint>
 #include <unordered_map>
 
-#include "slice/polygon_ops.hpp"
+#include "core/polygon_ops.hpp"
+#include "nonplanar/slice.hpp"
 
 namespace nonplanar {
 namespace {
@@ -119,20 +120,6 @@ std::vector<Polygon> layer_loops(const TriangleMesh& m, const std::vector<int>& 
 
 }  // namespace
 
-double area(const std::vector<ExPolygon>& polys) {
-  auto a = [](const Polygon& p) {
-    double s = 0;
-    for (std::size_t i = 0, j = p.size() - 1; i < p.size(); j = i++)
-      s += p[j].x() * p[i].y() - p[i].x() * p[j].y();
-    return 0.5 * s;
-  };
-  double s = 0;
-  for (const ExPolygon& e : polys) {
-    s += std::abs(a(e.contour));
-    for (const Polygon& h : e.holes) s -= std::abs(a(h));
-  }
-  return s;
-}
 
 Expected<std::vector<SlicedLayer>> slice_mesh(const TriangleMesh& mesh, const SliceParams& p,
                                               const Context& ctx) {

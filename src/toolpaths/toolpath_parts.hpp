@@ -8,7 +8,8 @@
 #include <vector>
 
 #include "nonplanar/toolpaths.hpp"
-#include "slice/polygon_ops.hpp"
+#include "core/polygon_ops.hpp"
+#include "nonplanar/slice.hpp"
 
 namespace nonplanar::paths {
 

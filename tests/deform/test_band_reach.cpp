@@ -1,5 +1,5 @@
 // Where a curved band bends the layers (BandedField::reach), and the two stages that rely on
-// it. The safety gate looks for collisions only near bands (deform/gate_zones.hpp): that must
+// it. The safety gate looks for collisions only near bands (pipeline/gate_zones.hpp): that must
 // lose nothing, so with a printer so tight that the curved layers collide a lot, the gate's
 // count equals the full check's while it reads far fewer moves. Mapping back splits a line
 // wherever it crosses a band, even when its ends and middle are planar.
@@ -7,7 +7,7 @@
 
 #include <cmath>
 
-#include "deform/gate_zones.hpp"
+#include "pipeline/gate_zones.hpp"
 #include "nonplanar/deform.hpp"
 #include "nonplanar/gcode.hpp"
 #include "nonplanar/pipeline.hpp"

@@ -1,4 +1,4 @@
-// PrusaSlicer as the planar engine (src/slice/external_engine.cpp): it slices the normalised
+// PrusaSlicer as the planar engine (src/engine/external_engine.cpp): it slices the normalised
 // mesh with the user's profile and its G-code is mapped back. Skipped where prusa-slicer is
 // not installed (scripts/test.sh installs it).
 #include <gtest/gtest.h>

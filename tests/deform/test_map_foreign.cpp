@@ -5,7 +5,7 @@
 
 #include "nonplanar/check.hpp"
 #include "nonplanar/deform.hpp"
-#include "nonplanar/fit.hpp"
+#include "nonplanar/patch_fit.hpp"
 #include "nonplanar/gcode.hpp"
 #include "nonplanar/pipeline.hpp"
 #include "support/solids.hpp"

@@ -1,10 +1,10 @@
-// The shell route through an external engine (src/deform/shell_engine.cpp): the slab cut
+// The shell route through an external engine (src/engine/shell_engine.cpp): the slab cut
 // from the normalised mesh, and the core's layers cut back (map_foreign_gcode's clip).
 #include <gtest/gtest.h>
 
 #include <map>
 
-#include "deform/shell_engine.hpp"
+#include "engine/shell_engine.hpp"
 #include "nonplanar/deform.hpp"
 #include "support/solids.hpp"
 

@@ -3,7 +3,7 @@
 #include <cmath>
 #include <functional>
 
-#include "nonplanar/fit.hpp"
+#include "nonplanar/patch_fit.hpp"
 #include "support/solids.hpp"
 
 namespace nonplanar {

@@ -2,7 +2,7 @@
 
 #include <sstream>
 
-#include "nonplanar/fit.hpp"
+#include "nonplanar/patch_fit.hpp"
 #include "nonplanar/surface_io.hpp"
 #include "support/files.hpp"
 #include "support/solids.hpp"

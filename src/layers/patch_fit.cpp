@@ -1,8 +1,9 @@
-// Samples of a patch's triangles: the fit's data and the error measurement.
+// A surface per patch: samples of its triangles as the fit's data, and the fit's error
+// measured against them.
 #include <algorithm>
 #include <cmath>
 
-#include "nonplanar/fit.hpp"
+#include "nonplanar/patch_fit.hpp"
 
 namespace nonplanar {
 namespace {

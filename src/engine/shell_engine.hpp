@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "layers/shell_plan.hpp"
-#include "nonplanar/pipeline.hpp"
+#include "engine/engine_route.hpp"
 
 namespace nonplanar {
 
@@ -20,7 +20,7 @@ struct EngineShell {
 /// points of an edge are computed from its ends in one order, so neighbours agree.
 TriangleMesh cut_below(const TriangleMesh& mesh, double z0);
 
-/// Inputs: the placed mesh, an accepted plan (plan.refused empty), the job (its engine is
+/// Inputs: the placed mesh, an accepted plan (plan.refused empty), the route (its engine is
 /// PrusaSlicer). Output: one program: the core run's start G-code and layers, each cut back to
 /// where z_k <= B + a (as shell_toolpaths), then the shell run's layers mapped onto the shell
 /// (entered from where the core ended, its retraction given back), then the core run's end
@@ -28,6 +28,6 @@ TriangleMesh cut_below(const TriangleMesh& mesh, double z0);
 /// profile); the shell run slices the normalised mesh above ζ = 0 as a slab (no skirt,
 /// first-layer settings neutral). Errors: those of the engine and the mapping; cancelled.
 Expected<EngineShell> shell_with_engine(const TriangleMesh& mesh, const layers::ShellPlan& plan,
-                                        const SliceJob& job, const Context& ctx);
+                                        const EngineRoute& job, const Context& ctx);
 
 }  // namespace nonplanar

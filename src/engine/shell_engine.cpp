@@ -1,6 +1,6 @@
 // Notation as in layers/shell_plan.hpp: H the top, N shell layers of thickness t, B = H − N·t,
 // a the reach; the core's layer with top z is printed where z <= B + a.
-#include "deform/shell_engine.hpp"
+#include "engine/shell_engine.hpp"
 
 #include <algorithm>
 #include <array>
@@ -8,7 +8,7 @@
 #include <map>
 
 #include "nonplanar/deform.hpp"
-#include "slice/external_engine.hpp"
+#include "engine/external_engine.hpp"
 
 namespace nonplanar {
 namespace {
@@ -78,7 +78,7 @@ TriangleMesh cut_below(const TriangleMesh& mesh, double z0) {
 }
 
 Expected<EngineShell> shell_with_engine(const TriangleMesh& mesh, const layers::ShellPlan& plan,
-                                        const SliceJob& job, const Context& ctx) {
+                                        const EngineRoute& job, const Context& ctx) {
   // The core: the whole mesh sliced on the plan's boundaries (its skins then sit under the
   // real top, so the shell counts as their cover), each layer cut back under the shell.
   EngineRun core_run;

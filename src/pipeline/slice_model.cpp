@@ -6,169 +6,17 @@
 #include <functional>
 #include <optional>
 
-#include "deform/gate_zones.hpp"
-#include "deform/shell_engine.hpp"
-#include "deform/shell_toolpaths.hpp"
+#include "engine/engine_route.hpp"
+#include "engine/shell_engine.hpp"
+#include "engine/shell_toolpaths.hpp"
 #include "layers/banded_field.hpp"
 #include "nonplanar/deform.hpp"
-#include "nonplanar/gcode.hpp"
 #include "nonplanar/pipeline.hpp"
-#include "slice/external_engine.hpp"
+#include "pipeline/gate.hpp"
 
 namespace nonplanar {
 
-SliceJob make_job(const PrintConfig& print, double max_angle_deg) {
-  SliceJob j;
-  j.print = print;
-  j.analysis.max_angle_deg = max_angle_deg;
-  j.layers.layer_height = print.slice.layer_height;
-  j.layers.first_layer_height = print.slice.first_layer_height;
-  j.layers.max_angle_deg = max_angle_deg;
-  j.layers.min_layer_height = print.min_layer_height > 0
-                                  ? print.min_layer_height
-                                  : std::min(j.analysis.min_layer_height, print.slice.layer_height);
-  j.layers.max_layer_height =
-      print.max_layer_height > 0
-          ? print.max_layer_height
-          : std::min(print.paths.nozzle_diameter,
-                     std::max(1.5 * print.slice.layer_height,
-                              std::min(0.75 * print.paths.nozzle_diameter, 0.3)));
-  j.analysis.min_layer_height = j.layers.min_layer_height;
-  // A layer steeper than the nozzle's outer wall drags the wall through the layer under it
-  // (DESIGN.md §3): the cone bounds the slope, for the facets painted and the layers alike.
-  const double cone = print.toolhead.cone_angle_deg;
-  if (cone < max_angle_deg) {
-    char buf[160];
-    std::snprintf(buf, sizeof buf,
-                  "max_angle lowered from %.1f to %.1f deg: the nozzle's cone "
-                  "(nozzle_cone_angle) is no steeper",
-                  max_angle_deg, cone);
-    j.notices.emplace_back(buf);
-    j.analysis.max_angle_deg = j.layers.max_angle_deg = cone;
-  }
-  j.layers.toolhead = print.toolhead;
-  j.map_back.tip_radius = print.toolhead.tip_radius;
-  j.map_back.travel_lift = travel_lift(print.gcode.retract_lift);
-  j.check = check_params(print, j.layers.max_angle_deg);
-  return j;
-}
-
 namespace {
-
-// A part thinner than one extrusion, or an open sheet, slices to nothing: say so rather than
-// write G-code that only draws a skirt (a lone sloped triangle once gave exit 0, a header
-// claiming 274 core layers, and no extrusion).
-std::optional<Error> nothing_to_print(const SliceResult& r, const TriangleMesh& mesh) {
-  const bool prints = std::any_of(r.layers.begin(), r.layers.end(), [](const LayerToolpaths& L) {
-    return std::any_of(L.paths.begin(), L.paths.end(), [](const ExtrusionPath& p) {
-      return p.role != ExtrusionRole::skirt && p.points.size() >= 2;
-    });
-  });
-  if (prints) return std::nullopt;
-  const BoundingBox b = bounding_box(mesh);
-  char buf[240];
-  std::snprintf(buf, sizeof buf,
-                "nothing to print: the part (%.2f x %.2f x %.2f mm) holds no volume one "
-                "extrusion can fill (smaller than a line, or an open surface)",
-                b.size().x(), b.size().y(), b.size().z());
-  return Error{Status::invalid_mesh, buf};
-}
-
-// Safety (DESIGN.md §3) on r.layers, rounded first to the µm they are written with (so
-// `check` on the file agrees with this gate even for a point at the collision depth's edge):
-// thickness and slope from the paths themselves, collisions with earlier layers from the
-// independent check, looked for only near a band's curved layers when `banded` is given
-// (gate_zones.hpp), everywhere else. Every breach goes to `violation`; false when it said stop.
-// Fills r's figures.
-using Violation = std::function<bool(const Vec3&, const char*)>;
-Expected<bool> gate(SliceResult& r, const SliceJob& job, const layers::BandedField* banded,
-                    const Violation& violation, const Context& ctx) {
-  for (LayerToolpaths& layer : r.layers)
-    for (ExtrusionPath& p : layer.paths)
-      for (Vec3& v : p.points) v = (v * 1000.0).array().round() / 1000.0;
-  const LayerParams& L = job.layers;
-  r.thickness_min = 1e300, r.thickness_max = 0;
-  const double tan_max = std::tan((L.max_angle_deg + 0.5) * M_PI / 180.0);
-  for (std::size_t li = 0; li < r.layers.size(); ++li)
-    for (const ExtrusionPath& p : r.layers[li].paths) {
-      if (p.role == ExtrusionRole::skirt) continue;
-      for (std::size_t k = 0; k < p.points.size(); ++k) {
-        if (li > 0) {
-          r.thickness_min = std::min(r.thickness_min, p.height[k]);
-          r.thickness_max = std::max(r.thickness_max, p.height[k]);
-          if ((p.height[k] < L.min_layer_height - 1e-3 ||
-               p.height[k] > L.max_layer_height + 1e-3) &&
-              !violation(p.points[k], "a layer leaves the thickness limits"))
-            return false;
-        }
-        if (k == 0) continue;
-        const double dxy = (p.points[k] - p.points[k - 1]).head<2>().norm();
-        const double dz = std::abs(p.points[k].z() - p.points[k - 1].z());
-        if (dxy > 0.05) r.steepest_deg = std::max(r.steepest_deg, std::atan2(dz, dxy) * 180 / M_PI);
-        if (dxy > 0.05 && dz > tan_max * dxy &&
-            !violation(p.points[k], "an extrusion is steeper than max_angle"))
-          return false;
-      }
-    }
-  if (r.thickness_min > r.thickness_max) r.thickness_min = r.thickness_max = 0;
-  if (!r.nonplanar) return true;  // planar layers cannot dig into earlier ones
-  // Collisions are looked for even when bands already broke a limit, so one retry drops
-  // every offender (each retry replans, reslices and rechecks the whole part).
-  CheckParams cp = job.check;
-  cp.collisions_only = true;
-  // Only where a curved layer is within the head's reach (gate_zones.hpp): on the bunny that
-  // skipped most of 24 million extrusion samples.
-  GateZones zones = banded ? gate_zones(*banded, cp.toolhead.reach()) : GateZones{};
-  zones.find_last_layers(r.layers);
-  cp.collision_zones = zones.query;
-  auto figures = check_print(moves_from_toolpaths(r.layers, job.print.gcode,
-                                                  [&](const ExtrusionPath& p, int li) {
-                                                    return !banded || zones.may_matter(p, li);
-                                                  }),
-                             nullptr, cp, ctx);
-  if (!figures) return figures.error();
-  r.collisions = figures->collisions;
-  if (figures->collisions > 0)
-    for (const Vec3& p : figures->collision_points)
-      if (!violation(p, "an extrusion would hit earlier layers")) return false;
-  return true;
-}
-
-// Our header on top of the engine's file: what was curved, and what was forced on it.
-// shell_first_layer > 0: the shell route's, with its core's first layer height (mm).
-std::string engine_header(const SliceJob& job, const std::vector<std::string>& header,
-                          double shell_first_layer) {
-  std::string head = "; generated by nonplanar 0.1.0 with ";
-  head += job.engine.engine == Engine::orcaslicer ? "OrcaSlicer" : "PrusaSlicer";
-  head += " as the planar engine\n";
-  for (const std::string& h : header) head += "; " + h + "\n";
-  for (const std::string& f : engine_forced_settings(job.engine, job.print))
-    head += "; engine setting: " + f + "\n";
-  if (shell_first_layer > 0)
-    for (const std::string& f : engine_shell_settings(shell_first_layer))
-      head += "; engine setting: " + f + "\n";
-  return head;
-}
-
-// The external engine's route: it slices `to_slice` (the normalised mesh, or the mesh when
-// nothing is curved) and its G-code is mapped back through the plan's field (the planar field
-// when nothing is curved, which keeps every point). Fills r.gcode, r.layers and the header.
-Expected<bool> slice_with_engine(const TriangleMesh& to_slice, const SliceJob& job, SliceResult& r,
-                                 const Context& ctx) {
-  auto text = run_engine(job.engine, to_slice, job.print, ctx);
-  if (!text) return text.error();
-  const auto planar = planar_field(job.layers);
-  const LayerField& field = r.nonplanar ? *r.plan.field : *planar;
-  auto mapped = map_foreign_gcode(*text, field, job.map_back, ctx);
-  if (!mapped) {
-    Error e = mapped.error();
-    e.message = "engine G-code, " + e.message;
-    return e;
-  }
-  r.layers = std::move(mapped->layers);
-  r.gcode = engine_header(job, r.header, 0) + mapped->text;
-  return true;
-}
 
 // One attempt with the patches not in `excluded`. When no stack can be built and `deferred` is
 // given, it is set and the result is returned unsliced (the caller tries a shell first). On a limit
@@ -234,22 +82,11 @@ Expected<SliceResult> attempt(const TriangleMesh& mesh, const SliceJob& job, con
       }
     }
   }
-  if (job.engine.engine != Engine::builtin) {
-    auto sliced = slice_with_engine(*to_slice, job, r, ctx);
-    if (!sliced) return sliced.error();
-  } else {
-    auto sliced = slice_mesh(*to_slice, job.print.slice, ctx);
-    if (!sliced) return sliced.error();
-    auto paths = make_toolpaths(*sliced, job.print.paths, ctx);
-    if (!paths) return paths.error();
-    if (!r.nonplanar) {
-      r.layers = std::move(*paths);
-    } else {
-      auto mapped = map_toolpaths_back(*paths, *r.plan.field, job.map_back, ctx);
-      if (!mapped) return mapped.error();
-      r.layers = std::move(*mapped);
-    }
-  }
+  const EngineRoute route{job.engine, job.print, job.layers, job.map_back};
+  auto sliced = slice_with(*to_slice, r.nonplanar ? r.plan.field.get() : nullptr, route, ctx);
+  if (!sliced) return sliced.error();
+  r.layers = std::move(sliced->layers);
+  if (!sliced->gcode.empty()) r.gcode = engine_header(route, r.header, 0) + sliced->gcode;
   // The band a location belongs to: the one whose blend weight β is largest there (the
   // stacks and the field's bands are in the same order).
   const auto* banded = dynamic_cast<const layers::BandedField*>(r.plan.field.get());
@@ -306,12 +143,13 @@ Expected<std::optional<SliceResult>> try_shell(const TriangleMesh& mesh, const S
     return std::optional<SliceResult>{};
   }
   SliceResult r;
+  const EngineRoute route{job.engine, job.print, job.layers, job.map_back};
   if (job.engine.engine == Engine::builtin) {
     auto paths = shell_toolpaths(mesh, plan, job.print, ctx);
     if (!paths) return paths.error();
     r.layers = std::move(*paths);
   } else {
-    auto printed = shell_with_engine(mesh, plan, job, ctx);
+    auto printed = shell_with_engine(mesh, plan, route, ctx);
     if (!printed && printed.error().status == Status::unsupported) {
       planar.notices.push_back(name + " not printed as a shell: " + printed.error().message);
       return std::optional<SliceResult>{};
@@ -333,7 +171,7 @@ Expected<std::optional<SliceResult>> try_shell(const TriangleMesh& mesh, const S
     if (!about_shell && n.rfind("no patch can", 0) != 0) r.notices.push_back(n);
   }
   r.notices.push_back(name + ": curved shell over a planar core (no stack over a plane fits it)");
-  if (!r.gcode.empty()) r.gcode = engine_header(job, r.header, plan.core.at(1)) + r.gcode;
+  if (!r.gcode.empty()) r.gcode = engine_header(route, r.header, plan.core.at(1)) + r.gcode;
   r.nonplanar = true;
   r.shell_layers = plan.N;
   std::string breach;

@@ -1,4 +1,4 @@
-#include "slice/external_engine.hpp"
+#include "engine/external_engine.hpp"
 
 #include <fcntl.h>
 #include <signal.h>

@@ -1,4 +1,4 @@
-#include "deform/gate_zones.hpp"
+#include "pipeline/gate_zones.hpp"
 
 #include <algorithm>
 

@@ -1,6 +1,25 @@
-#include "slice/polygon_ops.hpp"
+#include "core/polygon_ops.hpp"
 
-#include "slice/clipper_convert.hpp"
+#include "core/clipper_convert.hpp"
+
+namespace nonplanar {
+
+double area(const std::vector<ExPolygon>& polys) {
+  auto a = [](const Polygon& p) {
+    double s = 0;
+    for (std::size_t i = 0, j = p.size() - 1; i < p.size(); j = i++)
+      s += p[j].x() * p[i].y() - p[i].x() * p[j].y();
+    return 0.5 * s;
+  };
+  double s = 0;
+  for (const ExPolygon& e : polys) {
+    s += std::abs(a(e.contour));
+    for (const Polygon& h : e.holes) s -= std::abs(a(h));
+  }
+  return s;
+}
+
+}  // namespace nonplanar
 
 namespace nonplanar::clip {
 namespace {

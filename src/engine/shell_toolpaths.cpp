@@ -1,4 +1,4 @@
-#include "deform/shell_toolpaths.hpp"
+#include "engine/shell_toolpaths.hpp"
 
 #include <tbb/parallel_for.h>
 
@@ -6,7 +6,7 @@
 
 #include "layers/height_contour.hpp"
 #include "nonplanar/deform.hpp"
-#include "slice/polygon_ops.hpp"
+#include "core/polygon_ops.hpp"
 
 namespace nonplanar {
 

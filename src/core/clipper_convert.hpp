@@ -6,7 +6,7 @@
 
 #include <cmath>
 
-#include "nonplanar/slice.hpp"
+#include "nonplanar/polygon.hpp"
 
 namespace nonplanar::clip {
 

@@ -6,7 +6,10 @@
 #include <string>
 #include <vector>
 
-#include "nonplanar/pipeline.hpp"
+#include "nonplanar/config.hpp"
+#include "nonplanar/context.hpp"
+#include "nonplanar/engine.hpp"
+#include "nonplanar/mesh.hpp"
 
 namespace nonplanar {
 

@@ -3,7 +3,7 @@
 
 #include <vector>
 
-#include "nonplanar/slice.hpp"
+#include "nonplanar/polygon.hpp"
 
 namespace nonplanar::clip {
 

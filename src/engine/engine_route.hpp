@@ -1,0 +1,45 @@
+// The planar engines behind the pipeline: each slices a (normalised) mesh and returns its
+// layers mapped back onto the curved ones, the external ones with their whole program.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "nonplanar/config.hpp"
+#include "nonplanar/deform.hpp"
+#include "nonplanar/engine.hpp"
+#include "nonplanar/layers.hpp"
+
+namespace nonplanar {
+
+/// What an engine needs of the job: which engine, the print settings (they must agree with
+/// the engine's profile), the layer limits (the planar field when nothing is curved) and how
+/// paths are mapped back.
+struct EngineRoute {
+  const EngineParams& engine;
+  const PrintConfig& print;
+  const LayerParams& layers;
+  const MapBackParams& map_back;
+};
+
+/// A sliced part: its layers mapped back (the gate's input) and, from an external engine,
+/// the whole program (its start and end G-code and settings kept; without our header).
+struct EngineOutput {
+  std::vector<LayerToolpaths> layers;
+  std::string gcode;  ///< empty: the built-in engine's (write `layers` with make_gcode)
+};
+
+/// Inputs: the mesh to slice (the normalised one, or the placed mesh when nothing is
+/// curved), the plan's field (null: nothing is curved, the layers are kept as sliced).
+/// Output: the built-in engine's layers, or the external engine's program mapped back.
+/// Errors: those of the stages and of the engine (the message names it), cancelled.
+Expected<EngineOutput> slice_with(const TriangleMesh& to_slice, const LayerField* field,
+                                  const EngineRoute& route, const Context& ctx);
+
+/// Our header over an external engine's file: the route, `header` (what was curved) and the
+/// settings forced on the engine's runs; shell_first_layer > 0: the shell route's, with its
+/// core's first layer height (mm). Lines end with '\n'.
+std::string engine_header(const EngineRoute& route, const std::vector<std::string>& header,
+                          double shell_first_layer);
+
+}  // namespace nonplanar
