@@ -22,13 +22,6 @@ struct CheckParams {
   Toolhead toolhead;          ///< what may not touch earlier material (toolhead.hpp)
   double filament_diameter = 1.75;
   double surface_samples_per_mm2 = 2;
-  /// Only steepest extrusion and collisions (the slicer's safety gate, which measures
-  /// thickness from its own paths): thickness, volume and deviation are left at 0.
-  bool collisions_only = false;
-  /// When not empty, collisions are looked for only at extrusion points inside these boxes
-  /// (every extrusion still counts as material). For a caller that knows no point outside
-  /// them can collide, as the slicer's gate does: two planar layers never do.
-  std::vector<BoundingBox> collision_zones;
 };
 
 /// The figures of DESIGN.md §4. Deviation is vertical, mm; thickness is the height of each
@@ -52,6 +45,24 @@ struct CheckFigures {
 /// The check's settings for a print made with `print` (layer height, filament, toolhead) and
 /// facets up to `max_angle_deg` printable: the gate and `check` build them alike.
 CheckParams check_params(const PrintConfig& print, double max_angle_deg);
+
+/// Collisions with earlier layers (DESIGN.md §3), the search check_print runs, alone: for a
+/// caller that needs no other figure (the slicer's safety gate). Points are looked at only
+/// where `looked_at` says (null: everywhere): a caller that knows no point elsewhere can
+/// collide (two planar layers never do) saves the rest; every extrusion still counts as
+/// material. Errors: invalid_argument (extrusions spanning more than 2 m), cancelled.
+struct CollisionFigures {
+  std::size_t collisions = 0;
+  Vec3 first_collision{0, 0, 0};
+  int first_collision_line = 0;
+  std::vector<Vec3> points;  ///< where (≤ 4096, ≥ 1 mm apart)
+  std::size_t extrusions = 0;
+  double steepest_deg = 0;
+};
+Expected<CollisionFigures> find_collisions(const std::vector<PrintMove>& moves,
+                                           const CheckParams& params,
+                                           const std::function<bool(const Vec3&)>& looked_at,
+                                           const Context& ctx);
 
 /// Computes the figures; `mesh` (placed like the G-code) may be null, then deviation,
 /// volume ratio and outside fraction are left at 0. Errors: cancelled.

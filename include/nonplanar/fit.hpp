@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
-#include "nonplanar/mesh.hpp"
 #include "nonplanar/context.hpp"
+#include "nonplanar/mesh.hpp"
 #include "nonplanar/nurbs.hpp"
 #include "nonplanar/status.hpp"
 

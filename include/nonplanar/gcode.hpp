@@ -15,13 +15,6 @@
 
 namespace nonplanar {
 
-/// The same moves straight from toolpaths (for the check before a file is written); when
-/// `keep` is given, only the paths it accepts, called with each path and its layer (the
-/// travel to the next kept path starts where the last kept one ended).
-std::vector<PrintMove> moves_from_toolpaths(
-    const std::vector<LayerToolpaths>& layers, const GcodeParams& g,
-    const std::function<bool(const ExtrusionPath&, int layer)>& keep = nullptr);
-
 /// Filament length (mm) per mm of path for a bead of width w, height h (Slic3r's model).
 double filament_per_mm(double width, double height, const GcodeParams& g);
 

@@ -288,6 +288,193 @@ class Deposit {
   std::vector<Cell> level_[kLevels];  ///< per block of each level, split like the cells
 };
 
+constexpr double kMaxSpan = 2000.0;  // mm: larger than any bed we know; 2.4 GB of grid at most
+
+bool counts(const PrintMove& m) {
+  return m.extruding && m.layer >= 0 && m.type != "Skirt/Brim";
+}
+
+// The extrusion points (every 0.2 mm along each counted move: the coverage test allows half
+// of that beyond half a line width) and what the moves add up to.
+struct Samples {
+  std::vector<Pt> pts;  ///< only when asked for
+  Vec2 lo{1e300, 1e300}, hi{-1e300, -1e300};
+  double filament = 0;
+  std::size_t extrusions = 0;
+  double steepest_deg = 0;
+};
+
+Expected<Samples> sample_extrusions(const std::vector<PrintMove>& moves, bool points) {
+  Samples s;
+  for (const PrintMove& m : moves) {
+    if (!counts(m)) continue;
+    s.filament += m.filament;
+    const double len = (m.to - m.from).norm();
+    const int n = std::max(1, static_cast<int>(std::ceil(len / 0.2)));
+    s.lo = s.lo.cwiseMin(m.from.head<2>().cwiseMin(m.to.head<2>()));
+    s.hi = s.hi.cwiseMax(m.from.head<2>().cwiseMax(m.to.head<2>()));
+    // The grids below hold 0.2 mm cells over the extrusions' box: one move 10 m off once
+    // asked for 6.8 GB. Checked before this move is sampled.
+    if ((s.hi - s.lo).maxCoeff() > kMaxSpan) {
+      char buf[200];
+      std::snprintf(buf, sizeof buf,
+                    "line %d: extrusions span %.0f x %.0f mm; check measures prints up to %.0f mm "
+                    "across (a move far off the bed?)",
+                    m.line, s.hi.x() - s.lo.x(), s.hi.y() - s.lo.y(), kMaxSpan);
+      return Error{Status::invalid_argument, buf};
+    }
+    s.extrusions += static_cast<std::size_t>(n);
+    if (points)
+      for (int k = 1; k <= n; ++k)
+        s.pts.push_back({m.from + (m.to - m.from) * (static_cast<double>(k) / n), m.layer,
+                         m.type == "Internal infill"});
+    const double dxy = (m.to.head<2>() - m.from.head<2>()).norm();
+    if (dxy > 0.05)
+      s.steepest_deg =
+          std::max(s.steepest_deg, std::atan2(std::abs(m.to.z() - m.from.z()), dxy) * 180 / M_PI);
+  }
+  return s;
+}
+
+// The thickness at sample q: its height above the previous layer's extrusions there; false
+// where there is nothing to measure against (the first layer, a bridge, sparse infill far
+// below).
+bool thickness_at(const PointGrid& grid, const Pt& q, double* t) {
+  double below = 0;
+  *t = q.p.z();
+  Vec3 r(1e300, 0, 0);
+  const bool fits = q.layer > 0 && plane_z(grid, q.layer - 1, q.p.x(), q.p.y(), &below, &r, true);
+  // Nothing under it within 0.2 mm (a bridge, or a solid layer over sparse infill): a
+  // plane through lines farther away would be an extrapolation, not a thickness.
+  if (fits && (r.head<2>() - q.p.head<2>()).squaredNorm() > 0.2 * 0.2) return false;
+  if (fits) {
+    // This layer's height from the same kind of plane: where a curved stack bends (the
+    // rim of a patch) a plane through lines 0.45 mm apart misreads a layer's height by a
+    // few hundredths of a mm, and consecutive layers bend alike, so the two misreadings
+    // cancel in the difference. A single line here: its own height.
+    double here = q.p.z();
+    Vec3 line;
+    if (!plane_z(grid, q.layer, q.p.x(), q.p.y(), &here, &line, true)) here = q.p.z();
+    *t = here - below;
+    return true;
+  }
+  if (q.layer <= 0) return true;  // the first layer: its height above the bed
+  // The layer below is a single line here (the edge of a region, sparse infill): on a
+  // slope its nearest point's height is off by the slope times the distance, so
+  // measure at that point instead, carrying this sample's height there along this
+  // layer's slope (consecutive layers are nearly parallel). The slope, not the plane's
+  // height: at the edge of a region the plane is extrapolated past its last line and
+  // bends with the layer (0.06 mm high on the bunny). No point within 0.2 mm: a bridge,
+  // not a thickness.
+  double here = 0;
+  Vec3 unused;
+  Vec2 slope;
+  if (r.x() > 1e299 || (r.head<2>() - q.p.head<2>()).squaredNorm() > 0.2 * 0.2 ||
+      !plane_z(grid, q.layer, q.p.x(), q.p.y(), &here, &unused, true, &slope))
+    return false;
+  *t = q.p.z() + slope.dot(r.head<2>() - q.p.head<2>()) - r.z();
+  return true;
+}
+
+void measure_thickness(const PointGrid& grid, CheckFigures& f) {
+  f.thickness_min = 1e300, f.thickness_max = 0;
+  const std::vector<Pt>& all = grid.points();
+  for (std::size_t k = 0; k < all.size(); k += 3) {
+    double t = 0;
+    if (!thickness_at(grid, all[k], &t)) continue;
+    if (t < f.thickness_min) f.thickness_min = t, f.thickness_min_at = all[k].p;
+    if (t > f.thickness_max) f.thickness_max = t, f.thickness_max_at = all[k].p;
+  }
+  if (f.thickness_min > f.thickness_max) f.thickness_min = f.thickness_max = 0;
+}
+
+// Collisions, in print order, among the points `looked_at` accepts (null: all).
+Expected<CollisionFigures> search_collisions(const std::vector<PrintMove>& moves, const Samples& s,
+                                             const CheckParams& cp,
+                                             const std::function<bool(const Vec3&)>& looked_at,
+                                             const Context& ctx) {
+  CollisionFigures f;
+  // Material stands at most the print's height above the nozzle: higher parts of the head
+  // (a gantry) are left out, which keeps the search radius that of the parts that can touch.
+  double z_lo = 1e300, z_hi = -1e300;
+  for (const PrintMove& m : moves)
+    if (m.extruding && m.layer >= 0)
+      z_lo = std::min({z_lo, m.from.z(), m.to.z()}), z_hi = std::max({z_hi, m.from.z(), m.to.z()});
+  const HeadClearance head(cp.toolhead, z_hi - z_lo);
+  const double margin = head.reach() + 1;
+  Deposit dep(s.lo - Vec2(margin, margin), s.hi + Vec2(margin, margin), 0.2);
+  for (std::size_t mi = 0; mi < moves.size(); ++mi) {
+    const PrintMove& m = moves[mi];
+    if ((mi & 0xffff) == 0 && ctx.cancelled()) return Error{Status::cancelled, "cancelled"};
+    if (!m.extruding || m.layer < 0) continue;
+    const double len = (m.to - m.from).norm();
+    const int n = std::max(1, static_cast<int>(std::ceil(len / 0.2)));
+    for (int k = 1; k <= n; ++k) {
+      const Vec3 p = m.from + (m.to - m.from) * (static_cast<double>(k) / n);
+      if ((!looked_at || looked_at(p)) && dep.collides(p, m.layer, head, 0.5 * cp.layer_height)) {
+        if (f.collisions == 0) f.first_collision = p, f.first_collision_line = m.line;
+        // Spread out (1 mm apart at least): one long collision must not fill the list.
+        if (f.points.size() < 4096 && (f.points.empty() || (f.points.back() - p).norm() > 1.0))
+          f.points.push_back(p);
+        ++f.collisions;
+      }
+      dep.put(p, m.layer);
+    }
+  }
+  return f;
+}
+
+// Volume ratio and extrusion outside the mesh.
+void measure_volume(const PointGrid& grid, const TriangleMesh& mesh, double filament,
+                    const CheckParams& cp, CheckFigures& f) {
+  f.volume_ratio = filament * M_PI * 0.25 * cp.filament_diameter * cp.filament_diameter /
+                   std::max(signed_volume(mesh), 1e-12);
+  const ColumnCaster cols(mesh);
+  const std::vector<Pt>& all = grid.points();
+  std::size_t outside = 0, tested = 0;
+  for (std::size_t k = 0; k < all.size(); k += 2) {
+    ++tested;
+    // The bead lies under the nozzle: test a quarter layer below the nozzle tip.
+    if (!cols.inside(all[k].p.x(), all[k].p.y(), all[k].p.z() - 0.25 * cp.layer_height)) ++outside;
+  }
+  f.outside_fraction = tested ? static_cast<double>(outside) / static_cast<double>(tested) : 0.0;
+}
+
+// Top-surface deviation on printable up-facing facets.
+void measure_deviation(const PointGrid& grid, const TriangleMesh& mesh, const CheckParams& cp,
+                       CheckFigures& f) {
+  std::vector<double> dev;
+  const double cos_max = std::cos(cp.max_angle_deg * M_PI / 180.0);
+  for (const auto& t : mesh.faces) {
+    const Vec3 &a = mesh.vertices[t[0]], &b = mesh.vertices[t[1]], &c = mesh.vertices[t[2]];
+    const Vec3 nrm = (b - a).cross(c - a);
+    const double area = 0.5 * nrm.norm();
+    if (area <= 0 || nrm.z() / nrm.norm() <= cos_max) continue;
+    const int m = std::max(1, static_cast<int>(std::floor(
+                                  (std::sqrt(8 * cp.surface_samples_per_mm2 * area + 1) - 1) / 2)));
+    for (int i = 0; i < m; ++i)
+      for (int j = 0; i + j < m; ++j) {
+        const Vec3 s = a + (i + 1.0 / 3.0) / m * (b - a) + (j + 1.0 / 3.0) / m * (c - a);
+        ++f.surface_samples;
+        // The layer that prints this surface: the highest one whose extrusion covers this XY
+        // within half a line width, ignoring material more than 1 mm above it (another part
+        // of the model over this one, as an arch).
+        const int top = grid.top_layer(s.x(), s.y(), 0.225 + 0.1, s.z() + 1.0);
+        double z = 0;
+        if (top < 0 || !plane_z(grid, top, s.x(), s.y(), &z)) continue;
+        ++f.covered_samples;
+        dev.push_back(std::abs(z - s.z()));
+      }
+  }
+  if (dev.empty()) return;
+  std::sort(dev.begin(), dev.end());
+  double sum = 0;
+  for (double d : dev) sum += d;
+  f.deviation_mean = sum / static_cast<double>(dev.size());
+  f.deviation_p95 = dev[static_cast<std::size_t>(0.95 * static_cast<double>(dev.size() - 1))];
+  f.deviation_max = dev.back();
+}
+
 }  // namespace
 
 CheckParams check_params(const PrintConfig& print, double max_angle_deg) {
@@ -299,182 +486,39 @@ CheckParams check_params(const PrintConfig& print, double max_angle_deg) {
   return cp;
 }
 
-constexpr double kMaxSpan = 2000.0;  // mm: larger than any bed we know; 2.4 GB of grid at most
+Expected<CollisionFigures> find_collisions(const std::vector<PrintMove>& moves,
+                                           const CheckParams& params,
+                                           const std::function<bool(const Vec3&)>& looked_at,
+                                           const Context& ctx) {
+  auto s = sample_extrusions(moves, false);
+  if (!s) return s.error();
+  if (s->extrusions == 0) return CollisionFigures{};
+  auto f = search_collisions(moves, *s, params, looked_at, ctx);
+  if (f) f->extrusions = s->extrusions, f->steepest_deg = s->steepest_deg;
+  return f;
+}
 
 Expected<CheckFigures> check_print(const std::vector<PrintMove>& moves, const TriangleMesh* mesh,
                                    const CheckParams& cp, const Context& ctx) {
   CheckFigures f;
-  auto counts = [](const PrintMove& m) {
-    return m.extruding && m.layer >= 0 && m.type != "Skirt/Brim";
-  };
-  // Extrusion points and extents.
-  std::vector<Pt> pts;
-  Vec2 lo(1e300, 1e300), hi(-1e300, -1e300);
-  double filament = 0;
-  for (const PrintMove& m : moves) {
-    if (!counts(m)) continue;
-    filament += m.filament;
-    const double len = (m.to - m.from).norm();
-    // Every 0.2 mm: the coverage test below allows half of that beyond half a line width.
-    const int n = std::max(1, static_cast<int>(std::ceil(len / 0.2)));
-    lo = lo.cwiseMin(m.from.head<2>().cwiseMin(m.to.head<2>()));
-    hi = hi.cwiseMax(m.from.head<2>().cwiseMax(m.to.head<2>()));
-    // The grids below hold 0.2 mm cells over the extrusions' box: one move 10 m off once
-    // asked for 6.8 GB. Checked before this move is sampled.
-    if ((hi - lo).maxCoeff() > kMaxSpan) {
-      char buf[200];
-      std::snprintf(buf, sizeof buf,
-                    "line %d: extrusions span %.0f x %.0f mm; check measures prints up to %.0f mm "
-                    "across (a move far off the bed?)",
-                    m.line, hi.x() - lo.x(), hi.y() - lo.y(), kMaxSpan);
-      return Error{Status::invalid_argument, buf};
-    }
-    f.extrusions += static_cast<std::size_t>(n);
-    if (!cp.collisions_only)
-      for (int k = 1; k <= n; ++k)
-        pts.push_back({m.from + (m.to - m.from) * (static_cast<double>(k) / n), m.layer,
-                       m.type == "Internal infill"});
-    const double dxy = (m.to.head<2>() - m.from.head<2>()).norm();
-    if (dxy > 0.05)
-      f.steepest_deg =
-          std::max(f.steepest_deg, std::atan2(std::abs(m.to.z() - m.from.z()), dxy) * 180 / M_PI);
-  }
+  auto s = sample_extrusions(moves, true);
+  if (!s) return s.error();
+  f.extrusions = s->extrusions, f.steepest_deg = s->steepest_deg;
   if (f.extrusions == 0) return f;
   if (ctx.cancelled()) return Error{Status::cancelled, "cancelled"};
-
-  // Thickness: height above the previous layer's extrusions there (first layer: the bed).
-  std::optional<PointGrid> grid;
-  if (!cp.collisions_only) {
-    grid.emplace(std::move(pts));
-    f.thickness_min = 1e300, f.thickness_max = 0;
-    const std::vector<Pt>& all = grid->points();
-    for (std::size_t k = 0; k < all.size(); k += 3) {
-      const Pt& q = all[k];
-      double below = 0;
-      double t = q.p.z();
-      Vec3 r(1e300, 0, 0);
-      const bool fits =
-          q.layer > 0 && plane_z(*grid, q.layer - 1, q.p.x(), q.p.y(), &below, &r, true);
-      // Nothing under it within 0.2 mm (a bridge, or a solid layer over sparse infill): a
-      // plane through lines farther away would be an extrapolation, not a thickness.
-      if (fits && (r.head<2>() - q.p.head<2>()).squaredNorm() > 0.2 * 0.2) continue;
-      if (fits) {
-        // This layer's height from the same kind of plane: where a curved stack bends (the
-        // rim of a patch) a plane through lines 0.45 mm apart misreads a layer's height by a
-        // few hundredths of a mm, and consecutive layers bend alike, so the two misreadings
-        // cancel in the difference. A single line here: its own height.
-        double here = q.p.z();
-        Vec3 line;
-        if (!plane_z(*grid, q.layer, q.p.x(), q.p.y(), &here, &line, true)) here = q.p.z();
-        t = here - below;
-      } else if (q.layer > 0) {
-        // The layer below is a single line here (the edge of a region, sparse infill): on a
-        // slope its nearest point's height is off by the slope times the distance, so
-        // measure at that point instead, carrying this sample's height there along this
-        // layer's slope (consecutive layers are nearly parallel). The slope, not the plane's
-        // height: at the edge of a region the plane is extrapolated past its last line and
-        // bends with the layer (0.06 mm high on the bunny). No point within 0.2 mm: a bridge,
-        // not a thickness.
-        double here = 0;
-        Vec3 unused;
-        Vec2 slope;
-        if (r.x() > 1e299 || (r.head<2>() - q.p.head<2>()).squaredNorm() > 0.2 * 0.2 ||
-            !plane_z(*grid, q.layer, q.p.x(), q.p.y(), &here, &unused, true, &slope))
-          continue;
-        t = q.p.z() + slope.dot(r.head<2>() - q.p.head<2>()) - r.z();
-      }
-      if (t < f.thickness_min) f.thickness_min = t, f.thickness_min_at = q.p;
-      if (t > f.thickness_max) f.thickness_max = t, f.thickness_max_at = q.p;
-    }
-    if (f.thickness_min > f.thickness_max) f.thickness_min = f.thickness_max = 0;
-  }
+  const PointGrid grid(std::move(s->pts));
+  measure_thickness(grid, f);
   if (ctx.cancelled()) return Error{Status::cancelled, "cancelled"};
   ctx.progress("check", 0.3);
-
-  // Collisions, in print order.
-  auto in_zone = [&](const Vec3& p) {
-    if (cp.collision_zones.empty()) return true;
-    for (const BoundingBox& z : cp.collision_zones)
-      if (z.contains(p)) return true;
-    return false;
-  };
-  // Material stands at most the print's height above the nozzle: higher parts of the head
-  // (a gantry) are left out, which keeps the search radius that of the parts that can touch.
-  double z_lo = 1e300, z_hi = -1e300;
-  for (const PrintMove& m : moves)
-    if (m.extruding && m.layer >= 0)
-      z_lo = std::min({z_lo, m.from.z(), m.to.z()}), z_hi = std::max({z_hi, m.from.z(), m.to.z()});
-  const HeadClearance head(cp.toolhead, z_hi - z_lo);
-  const double margin = head.reach() + 1;
-  Deposit dep(lo - Vec2(margin, margin), hi + Vec2(margin, margin), 0.2);
-  for (std::size_t mi = 0; mi < moves.size(); ++mi) {
-    const PrintMove& m = moves[mi];
-    if ((mi & 0xffff) == 0 && ctx.cancelled()) return Error{Status::cancelled, "cancelled"};
-    if (!m.extruding || m.layer < 0) continue;
-    const double len = (m.to - m.from).norm();
-    const int n = std::max(1, static_cast<int>(std::ceil(len / 0.2)));
-    for (int k = 1; k <= n; ++k) {
-      const Vec3 p = m.from + (m.to - m.from) * (static_cast<double>(k) / n);
-      if (in_zone(p) && dep.collides(p, m.layer, head, 0.5 * cp.layer_height)) {
-        if (f.collisions == 0) f.first_collision = p, f.first_collision_line = m.line;
-        // Spread out (1 mm apart at least): one long collision must not fill the list.
-        if (f.collision_points.size() < 4096 &&
-            (f.collision_points.empty() || (f.collision_points.back() - p).norm() > 1.0))
-          f.collision_points.push_back(p);
-        ++f.collisions;
-      }
-      dep.put(p, m.layer);
-    }
-  }
+  auto c = search_collisions(moves, *s, cp, nullptr, ctx);
+  if (!c) return c.error();
+  f.collisions = c->collisions, f.first_collision = c->first_collision;
+  f.first_collision_line = c->first_collision_line, f.collision_points = std::move(c->points);
   ctx.progress("check", 0.6);
-  if (!mesh || !grid) return f;
+  if (!mesh) return f;
   if (ctx.cancelled()) return Error{Status::cancelled, "cancelled"};
-  const std::vector<Pt>& all = grid->points();
-
-  // Volume and extrusion outside the mesh.
-  f.volume_ratio = filament * M_PI * 0.25 * cp.filament_diameter * cp.filament_diameter /
-                   std::max(signed_volume(*mesh), 1e-12);
-  const ColumnCaster cols(*mesh);
-  std::size_t outside = 0, tested = 0;
-  for (std::size_t k = 0; k < all.size(); k += 2) {
-    ++tested;
-    // The bead lies under the nozzle: test a quarter layer below the nozzle tip.
-    if (!cols.inside(all[k].p.x(), all[k].p.y(), all[k].p.z() - 0.25 * cp.layer_height)) ++outside;
-  }
-  f.outside_fraction = tested ? static_cast<double>(outside) / static_cast<double>(tested) : 0.0;
-
-  // Top-surface deviation on printable up-facing facets.
-  std::vector<double> dev;
-  const double cos_max = std::cos(cp.max_angle_deg * M_PI / 180.0);
-  for (const auto& t : mesh->faces) {
-    const Vec3 &a = mesh->vertices[t[0]], &b = mesh->vertices[t[1]], &c = mesh->vertices[t[2]];
-    const Vec3 nrm = (b - a).cross(c - a);
-    const double area = 0.5 * nrm.norm();
-    if (area <= 0 || nrm.z() / nrm.norm() <= cos_max) continue;
-    const int m = std::max(1, static_cast<int>(std::floor(
-                                  (std::sqrt(8 * cp.surface_samples_per_mm2 * area + 1) - 1) / 2)));
-    for (int i = 0; i < m; ++i)
-      for (int j = 0; i + j < m; ++j) {
-        const Vec3 s = a + (i + 1.0 / 3.0) / m * (b - a) + (j + 1.0 / 3.0) / m * (c - a);
-        ++f.surface_samples;
-        // The highest layer whose extrusion covers this XY within half a line width.
-        // The layer that prints this surface: the highest one near it, ignoring material
-        // more than 1 mm above it (another part of the model over this one, as an arch).
-        const int top = grid->top_layer(s.x(), s.y(), 0.225 + 0.1, s.z() + 1.0);
-        double z = 0;
-        if (top < 0 || !plane_z(*grid, top, s.x(), s.y(), &z)) continue;
-        ++f.covered_samples;
-        dev.push_back(std::abs(z - s.z()));
-      }
-  }
-  if (!dev.empty()) {
-    std::sort(dev.begin(), dev.end());
-    double sum = 0;
-    for (double d : dev) sum += d;
-    f.deviation_mean = sum / static_cast<double>(dev.size());
-    f.deviation_p95 = dev[static_cast<std::size_t>(0.95 * static_cast<double>(dev.size() - 1))];
-    f.deviation_max = dev.back();
-  }
+  measure_volume(grid, *mesh, s->filament, cp, f);
+  measure_deviation(grid, *mesh, cp, f);
   ctx.progress("check", 1.0);
   return f;
 }

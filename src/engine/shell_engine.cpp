@@ -7,8 +7,8 @@
 #include <cstdio>
 #include <map>
 
-#include "nonplanar/deform.hpp"
 #include "engine/external_engine.hpp"
+#include "nonplanar/deform.hpp"
 
 namespace nonplanar {
 namespace {

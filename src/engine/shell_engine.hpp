@@ -5,8 +5,8 @@
 #include <string>
 #include <vector>
 
-#include "layers/shell_plan.hpp"
 #include "engine/engine_route.hpp"
+#include "layers/shell_plan.hpp"
 
 namespace nonplanar {
 

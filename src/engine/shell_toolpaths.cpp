@@ -4,9 +4,9 @@
 
 #include <algorithm>
 
+#include "core/polygon_ops.hpp"
 #include "layers/height_contour.hpp"
 #include "nonplanar/deform.hpp"
-#include "core/polygon_ops.hpp"
 
 namespace nonplanar {
 

@@ -1,7 +1,5 @@
 #include "io/mesh_buffer.hpp"
 
-
-
 namespace nonplanar::io {
 
 std::optional<Error> check_face_indices(const TriangleMesh& mesh) {

@@ -18,10 +18,10 @@ namespace nonplanar::io {
 
 // Reading files, the tokenizer and number parsing live in core/ (every parser uses them).
 using core::FileBytes;
-using core::read_file_bytes;
 using core::parse_double;
 using core::parse_error_at;
 using core::parse_int;
+using core::read_file_bytes;
 using core::Tokenizer;
 
 /// Checks that a triangle index list references existing vertices; returns an error naming

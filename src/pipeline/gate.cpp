@@ -10,6 +10,36 @@
 
 namespace nonplanar {
 
+std::vector<PrintMove> moves_from_toolpaths(
+    const std::vector<LayerToolpaths>& layers, const GcodeParams& g,
+    const std::function<bool(const ExtrusionPath&, int)>& keep) {
+  std::vector<PrintMove> out;
+  std::size_t n = 0;
+  for (const LayerToolpaths& L : layers)
+    for (const ExtrusionPath& p : L.paths) n += p.points.size();
+  out.reserve(n);
+  Vec3 pos(0, 0, 0);
+  for (std::size_t li = 0; li < layers.size(); ++li)
+    for (const ExtrusionPath& p : layers[li].paths) {
+      if (p.points.empty() || (keep && !keep(p, static_cast<int>(li)))) continue;
+      PrintMove t;
+      t.from = pos, t.to = p.points[0], t.layer = static_cast<int>(li), t.type = role_name(p.role);
+      t.width = p.width;
+      out.push_back(t);
+      for (std::size_t k = 1; k < p.points.size(); ++k) {
+        PrintMove m;
+        m.from = p.points[k - 1], m.to = p.points[k];
+        m.filament = (m.to - m.from).norm() *
+                     filament_per_mm(p.width, 0.5 * (p.height[k] + p.height[k - 1]), g);
+        m.extruding = m.filament > 0 && (m.to.head<2>() - m.from.head<2>()).norm() > 1e-9;
+        m.type = role_name(p.role), m.layer = static_cast<int>(li), m.width = p.width;
+        out.push_back(m);
+      }
+      pos = p.points.back();
+    }
+  return out;
+}
+
 // A part thinner than one extrusion, or an open sheet, slices to nothing: say so rather than
 // write G-code that only draws a skirt (a lone sloped triangle once gave exit 0, a header
 // claiming 274 core layers, and no extrusion).
@@ -69,21 +99,25 @@ Expected<bool> gate(SliceResult& r, const SliceJob& job, const layers::BandedFie
   // Collisions are looked for even when bands already broke a limit, so one retry drops
   // every offender (each retry replans, reslices and rechecks the whole part).
   CheckParams cp = job.check;
-  cp.collisions_only = true;
   // Only where a curved layer is within the head's reach (gate_zones.hpp): on the bunny that
   // skipped most of 24 million extrusion samples.
   GateZones zones = banded ? gate_zones(*banded, cp.toolhead.reach()) : GateZones{};
   zones.find_last_layers(r.layers);
-  cp.collision_zones = zones.query;
-  auto figures = check_print(moves_from_toolpaths(r.layers, job.print.gcode,
-                                                  [&](const ExtrusionPath& p, int li) {
-                                                    return !banded || zones.may_matter(p, li);
-                                                  }),
-                             nullptr, cp, ctx);
+  std::function<bool(const Vec3&)> looked_at;
+  if (!zones.query.empty())
+    looked_at = [&](const Vec3& p) {
+      return std::any_of(zones.query.begin(), zones.query.end(),
+                         [&](const BoundingBox& b) { return b.contains(p); });
+    };
+  auto figures = find_collisions(moves_from_toolpaths(r.layers, job.print.gcode,
+                                                      [&](const ExtrusionPath& p, int li) {
+                                                        return !banded || zones.may_matter(p, li);
+                                                      }),
+                                 cp, looked_at, ctx);
   if (!figures) return figures.error();
   r.collisions = figures->collisions;
   if (figures->collisions > 0)
-    for (const Vec3& p : figures->collision_points)
+    for (const Vec3& p : figures->points)
       if (!violation(p, "an extrusion would hit earlier layers")) return false;
   return true;
 }

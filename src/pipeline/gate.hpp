@@ -22,6 +22,13 @@ using Violation = std::function<bool(const Vec3&, const char*)>;
 Expected<bool> gate(SliceResult& r, const SliceJob& job, const layers::BandedField* banded,
                     const Violation& violation, const Context& ctx);
 
+/// The same moves straight from toolpaths (the gate's input, as the written file will hold them);
+/// when `keep` is given, only the paths it accepts, called with each path and its layer (the travel
+/// to the next kept path starts where the last kept one ended).
+std::vector<PrintMove> moves_from_toolpaths(
+    const std::vector<LayerToolpaths>& layers, const GcodeParams& g,
+    const std::function<bool(const ExtrusionPath&, int layer)>& keep = nullptr);
+
 /// A part thinner than one extrusion, or an open sheet, slices to nothing: the error that
 /// says so (invalid_mesh, with the part's size), or nothing when r prints something.
 std::optional<Error> nothing_to_print(const SliceResult& r, const TriangleMesh& mesh);

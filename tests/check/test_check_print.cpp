@@ -74,21 +74,24 @@ TEST(CheckPrint, NozzleBelowEarlierMaterialCollides) {
   EXPECT_EQ(f->collisions, 0u);
 }
 
-TEST(CheckPrint, CollisionsOnlyModeCountsTheSame) {
+TEST(CheckPrint, CollisionSearchAloneCountsTheSame) {
   std::vector<PrintMove> moves;
   raster(moves, 0, 10, 3, 1.5);
   raster(moves, 1, 12, 6, 0.4);  // partly beside, partly under the raised layer
   raster(moves, 2, 12, 6, 1.9);
-  CheckParams full, gate;
-  gate.collisions_only = true;
-  const auto a = check_print(moves, nullptr, full, {});
-  const auto b = check_print(moves, nullptr, gate, {});
+  const auto a = check_print(moves, nullptr, {}, {});
+  const auto b = find_collisions(moves, {}, nullptr, {});
   ASSERT_TRUE(a && b);
   EXPECT_GT(a->collisions, 0u);
   EXPECT_EQ(a->collisions, b->collisions);
   EXPECT_EQ(a->first_collision_line, b->first_collision_line);
+  EXPECT_EQ(a->collision_points.size(), b->points.size());
   EXPECT_EQ(a->extrusions, b->extrusions);
-  EXPECT_EQ(b->thickness_max, 0.0);  // not measured in the gate
+  // Looked at only where x < 5: fewer, and none at x >= 5.
+  const auto c = find_collisions(moves, {}, [](const Vec3& p) { return p.x() < 5; }, {});
+  ASSERT_TRUE(c);
+  EXPECT_LT(c->collisions, a->collisions);
+  for (const Vec3& p : c->points) EXPECT_LT(p.x(), 5.0);
 }
 
 // A top surface with other material high above it (an arch, a second body): the layer that

@@ -5,12 +5,13 @@
 // wherever it crosses a band, even when its ends and middle are planar.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
-#include "pipeline/gate_zones.hpp"
 #include "nonplanar/deform.hpp"
-#include "nonplanar/gcode.hpp"
 #include "nonplanar/pipeline.hpp"
+#include "pipeline/gate.hpp"
+#include "pipeline/gate_zones.hpp"
 #include "support/solids.hpp"
 
 namespace nonplanar {
@@ -49,9 +50,8 @@ TEST(GateZones, FindEveryCollisionTheFullCheckFinds) {
   CheckParams cp;
   cp.toolhead.block_clearance = 0.3;
   cp.toolhead.cone_angle_deg = 10;
-  cp.collisions_only = true;
   const std::vector<PrintMove> all = moves_from_toolpaths(r->layers, c.gcode);
-  auto full = check_print(all, nullptr, cp, {});
+  auto full = find_collisions(all, cp, nullptr, {});
   ASSERT_TRUE(full);
 
   GateZones zones = gate_zones(*field, cp.toolhead.reach());
@@ -59,14 +59,17 @@ TEST(GateZones, FindEveryCollisionTheFullCheckFinds) {
   ASSERT_EQ(zones.query.size(), 1u);
   const std::vector<PrintMove> near = moves_from_toolpaths(
       r->layers, c.gcode, [&](const ExtrusionPath& p, int li) { return zones.may_matter(p, li); });
-  cp.collision_zones = zones.query;
-  auto gated = check_print(near, nullptr, cp, {});
+  auto in_zones = [&](const Vec3& p) {
+    return std::any_of(zones.query.begin(), zones.query.end(),
+                       [&](const BoundingBox& b) { return b.contains(p); });
+  };
+  auto gated = find_collisions(near, cp, in_zones, {});
   ASSERT_TRUE(gated);
 
   EXPECT_GT(full->collisions, 100u);
   EXPECT_EQ(gated->collisions, full->collisions);
   EXPECT_EQ(gated->first_collision, full->first_collision);
-  EXPECT_EQ(gated->collision_points.size(), full->collision_points.size());
+  EXPECT_EQ(gated->points.size(), full->points.size());
   // The slab below the band is left out.
   EXPECT_LT(static_cast<double>(near.size()), 0.9 * static_cast<double>(all.size()));
 }
