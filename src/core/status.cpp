@@ -1,7 +1,5 @@
 #include "nonplanar/status.hpp"
 
-#include "nonplanar/io.hpp"
-
 namespace nonplanar {
 
 const char* status_name(Status s) {
@@ -22,22 +20,6 @@ const char* status_name(Status s) {
       return "unsupported";
     case Status::internal_error:
       return "internal error";
-  }
-  return "unknown";
-}
-
-const char* format_name(MeshFormat f) {
-  switch (f) {
-    case MeshFormat::stl_binary:
-      return "binary STL";
-    case MeshFormat::stl_ascii:
-      return "ASCII STL";
-    case MeshFormat::obj:
-      return "OBJ";
-    case MeshFormat::off:
-      return "OFF";
-    case MeshFormat::threemf:
-      return "3MF";
   }
   return "unknown";
 }

@@ -11,6 +11,23 @@
 #include "nonplanar/io.hpp"
 
 namespace nonplanar {
+
+const char* format_name(MeshFormat f) {
+  switch (f) {
+    case MeshFormat::stl_binary:
+      return "binary STL";
+    case MeshFormat::stl_ascii:
+      return "ASCII STL";
+    case MeshFormat::obj:
+      return "OBJ";
+    case MeshFormat::off:
+      return "OFF";
+    case MeshFormat::threemf:
+      return "3MF";
+  }
+  return "unknown";
+}
+
 namespace {
 
 constexpr double kMaxCoordinate = 1e7;  // mm; beyond this, doubles lose the weld tolerance
