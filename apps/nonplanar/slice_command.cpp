@@ -90,16 +90,14 @@ int run(const SliceOptions& o) {
   SliceJob job = make_job(cfg, o.max_angle);
   job.planar_only = o.planar;
   job.engine = engine;
+  job.header.push_back("model: " + o.mesh.model);
   auto result = slice_model(loaded->mesh, job, ctx);
   if (!result) {
     Error e = result.error();
     if (e.status == Status::invalid_mesh) e.message = o.mesh.model + ": " + e.message;
     return finish_progress(), report_error(e);
   }
-  std::vector<std::string> header = result->header;
-  header.push_back("model: " + o.mesh.model);
-  auto w = result->gcode.empty() ? write_gcode_file(o.output, result->layers, cfg, header, ctx)
-                                 : write_gcode_text(o.output, result->gcode, ctx);
+  auto w = write_gcode_text(o.output, result->gcode, ctx);
   finish_progress();
   if (!w) return report_error(w.error());
   report_warnings(o.mesh.model, *loaded, o.mesh.quiet);

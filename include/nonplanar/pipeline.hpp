@@ -26,6 +26,8 @@ struct SliceJob {
   /// user's profile and its G-code is mapped back (map_foreign_gcode). Layer heights and
   /// the bed come from `print`, which must agree with that profile.
   EngineParams engine;
+  /// More lines for the G-code's header, after the pipeline's own (the CLI names the model).
+  std::vector<std::string> header;
 };
 
 /// A job whose layer and check settings agree with the print configuration: heights, the
@@ -42,8 +44,9 @@ struct SliceResult {
   std::size_t collisions = 0;
   bool nonplanar = false;
   int shell_layers = 0;  ///< curved layers of a shell over a planar core (0: none)
-  /// The whole program, when an external engine sliced it (its start and end G-code and
-  /// settings kept); empty: write `layers` with write_gcode_file.
+  /// The whole program, as the safety gate checked it: the built-in writer's, or an external
+  /// engine's (its start and end G-code and settings kept) mapped back. Write it with
+  /// write_gcode_text.
   std::string gcode;
 };
 

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <string>
 #include <string_view>
@@ -112,13 +113,24 @@ struct PrintMove {
   Vec3 from{0, 0, 0}, to{0, 0, 0};
   double filament = 0;     ///< mm of filament pushed (negative: retraction)
   bool extruding = false;  ///< filament > 0 and the nozzle moved in XY
-  std::string type;        ///< the ;TYPE: in force ("" before any)
+  std::string_view type;   ///< the ;TYPE: in force ("" before any); views the text read
   int layer = -1;          ///< ;LAYER_CHANGE count − 1
   double width = 0.45;     ///< ;WIDTH: in force
   int line = 0;            ///< 1-based line in the file (0 for moves made in memory)
 };
 
-/// The moves of a G-code file, through read_gcode_program. Refused (parse_error naming the
+/// The same reading, streamed: f gets every G0/G1 in order and nothing else is kept, for a
+/// caller that wants only some moves of a large file. Returns the problems.
+std::vector<GcodeProblem> for_each_gcode_move(std::string_view text,
+                                              const std::function<void(const GcodeMove&)>& f);
+
+/// The moves of a file as check reads them; with `keep`, only those it accepts. Problems are
+/// not looked at (for a file this program wrote or mapped itself).
+std::vector<PrintMove> read_print_moves(
+    std::string_view text, const std::function<bool(const GcodeMove&)>& keep = nullptr);
+
+/// The moves of a G-code file, through read_gcode_program (their types view `text`, which
+/// must outlive them). Refused (parse_error naming the
 /// line): any problem but home and probe (arcs, inches, unknown G-codes, junk).
 Expected<std::vector<PrintMove>> read_gcode_moves(std::string_view text);
 

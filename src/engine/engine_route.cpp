@@ -1,11 +1,21 @@
 #include "engine/engine_route.hpp"
 
 #include "engine/external_engine.hpp"
+#include "engine/shell_engine.hpp"
+#include "engine/shell_toolpaths.hpp"
 #include "nonplanar/slice.hpp"
 #include "nonplanar/toolpaths.hpp"
 
 namespace nonplanar {
 namespace {
+
+// Points on the G-code's 1 µm grid (%.3f), before anything measures or writes them.
+EngineOutput on_file_grid(EngineOutput out) {
+  for (LayerToolpaths& layer : out.layers)
+    for (ExtrusionPath& p : layer.paths)
+      for (Vec3& v : p.points) v = (v * 1000.0).array().round() / 1000.0;
+  return out;
+}
 
 Expected<EngineOutput> builtin(const TriangleMesh& to_slice, const LayerField* field,
                                const EngineRoute& route, const Context& ctx) {
@@ -47,8 +57,26 @@ Expected<EngineOutput> external(const TriangleMesh& to_slice, const LayerField* 
 
 Expected<EngineOutput> slice_with(const TriangleMesh& to_slice, const LayerField* field,
                                   const EngineRoute& route, const Context& ctx) {
-  return route.engine.engine == Engine::builtin ? builtin(to_slice, field, route, ctx)
-                                                : external(to_slice, field, route, ctx);
+  auto out = route.engine.engine == Engine::builtin ? builtin(to_slice, field, route, ctx)
+                                                    : external(to_slice, field, route, ctx);
+  if (!out) return out;
+  return on_file_grid(std::move(*out));
+}
+
+Expected<EngineOutput> shell_with(const TriangleMesh& mesh, const layers::ShellPlan& plan,
+                                  const EngineRoute& route, const Context& ctx) {
+  EngineOutput out;
+  if (route.engine.engine == Engine::builtin) {
+    auto paths = shell_toolpaths(mesh, plan, route.print, ctx);
+    if (!paths) return paths.error();
+    out.layers = std::move(*paths);
+  } else {
+    auto printed = shell_with_engine(mesh, plan, route, ctx);
+    if (!printed) return printed.error();
+    out.layers = std::move(printed->layers);
+    out.gcode = std::move(printed->gcode);
+  }
+  return on_file_grid(std::move(out));
 }
 
 std::string engine_header(const EngineRoute& route, const std::vector<std::string>& header,

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "layers/shell_plan.hpp"
 #include "nonplanar/config.hpp"
 #include "nonplanar/deform.hpp"
 #include "nonplanar/engine.hpp"
@@ -31,9 +32,17 @@ struct EngineOutput {
 
 /// Inputs: the mesh to slice (the normalised one, or the placed mesh when nothing is
 /// curved), the plan's field (null: nothing is curved, the layers are kept as sliced).
-/// Output: the built-in engine's layers, or the external engine's program mapped back.
+/// Output: the built-in engine's layers, or the external engine's program mapped back; every
+/// point on the 1 µm grid the G-code holds (%.3f), so the gate's slopes are the file's.
 /// Errors: those of the stages and of the engine (the message names it), cancelled.
 Expected<EngineOutput> slice_with(const TriangleMesh& to_slice, const LayerField* field,
+                                  const EngineRoute& route, const Context& ctx);
+
+/// The shell plan printed by the route's engine: the built-in core and shell
+/// (shell_toolpaths), or the external engine's two runs stitched into one program
+/// (shell_with_engine). Errors: unsupported (the engine's core is off the plan's boundaries),
+/// those of the stages and the engine, cancelled.
+Expected<EngineOutput> shell_with(const TriangleMesh& mesh, const layers::ShellPlan& plan,
                                   const EngineRoute& route, const Context& ctx);
 
 /// Our header over an external engine's file: the route, `header` (what was curved) and the

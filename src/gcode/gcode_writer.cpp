@@ -145,7 +145,8 @@ std::string bed_text(const PrintConfig& c) {
 // Moves of a custom block that go off the bed. `prefix` sets the position it starts from.
 std::optional<Error> check_block_on_bed(const std::string& key, const std::string& block,
                                         const std::string& prefix, const PrintConfig& c) {
-  auto moves = read_gcode_moves(prefix + block);
+  const std::string text = prefix + block;
+  auto moves = read_gcode_moves(text);
   if (!moves) return Error{Status::invalid_argument, key + ": " + moves.error().message};
   const int skip = static_cast<int>(std::count(prefix.begin(), prefix.end(), '\n'));
   for (const PrintMove& m : *moves) {

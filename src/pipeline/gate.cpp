@@ -10,36 +10,6 @@
 
 namespace nonplanar {
 
-std::vector<PrintMove> moves_from_toolpaths(
-    const std::vector<LayerToolpaths>& layers, const GcodeParams& g,
-    const std::function<bool(const ExtrusionPath&, int)>& keep) {
-  std::vector<PrintMove> out;
-  std::size_t n = 0;
-  for (const LayerToolpaths& L : layers)
-    for (const ExtrusionPath& p : L.paths) n += p.points.size();
-  out.reserve(n);
-  Vec3 pos(0, 0, 0);
-  for (std::size_t li = 0; li < layers.size(); ++li)
-    for (const ExtrusionPath& p : layers[li].paths) {
-      if (p.points.empty() || (keep && !keep(p, static_cast<int>(li)))) continue;
-      PrintMove t;
-      t.from = pos, t.to = p.points[0], t.layer = static_cast<int>(li), t.type = role_name(p.role);
-      t.width = p.width;
-      out.push_back(t);
-      for (std::size_t k = 1; k < p.points.size(); ++k) {
-        PrintMove m;
-        m.from = p.points[k - 1], m.to = p.points[k];
-        m.filament = (m.to - m.from).norm() *
-                     filament_per_mm(p.width, 0.5 * (p.height[k] + p.height[k - 1]), g);
-        m.extruding = m.filament > 0 && (m.to.head<2>() - m.from.head<2>()).norm() > 1e-9;
-        m.type = role_name(p.role), m.layer = static_cast<int>(li), m.width = p.width;
-        out.push_back(m);
-      }
-      pos = p.points.back();
-    }
-  return out;
-}
-
 // A part thinner than one extrusion, or an open sheet, slices to nothing: say so rather than
 // write G-code that only draws a skirt (a lone sloped triangle once gave exit 0, a header
 // claiming 274 core layers, and no extrusion).
@@ -59,18 +29,21 @@ std::optional<Error> nothing_to_print(const SliceResult& r, const TriangleMesh& 
   return Error{Status::invalid_mesh, buf};
 }
 
-// Safety (DESIGN.md §3) on r.layers, rounded first to the µm they are written with (so
-// `check` on the file agrees with this gate even for a point at the collision depth's edge):
-// thickness and slope from the paths themselves, collisions with earlier layers from the
-// independent check, looked for only near a band's curved layers when `banded` is given
-// (gate_zones.hpp), everywhere else. Every breach goes to `violation`; false when it said stop.
-// Fills r's figures.
-Expected<bool> gate(SliceResult& r, const SliceJob& job, const layers::BandedField* banded,
-                    const Violation& violation, const Context& ctx) {
-  for (LayerToolpaths& layer : r.layers)
-    for (ExtrusionPath& p : layer.paths)
-      for (Vec3& v : p.points) v = (v * 1000.0).array().round() / 1000.0;
-  const LayerParams& L = job.layers;
+Expected<bool> write_program(SliceResult& r, const SliceJob& job, const Context& ctx) {
+  if (!r.gcode.empty()) return true;
+  std::vector<std::string> header = r.header;
+  header.insert(header.end(), job.header.begin(), job.header.end());
+  auto text = make_gcode(r.layers, job.print, header, ctx);
+  if (!text) return text.error();
+  r.gcode = std::move(*text);
+  return true;
+}
+
+namespace {
+
+// Thickness within [h_min, h_max] and slope within max_angle + 0.5° on the paths (their points
+// on the file's µm grid, engine_route.hpp); fills r's thickness and steepest figures.
+bool limits(SliceResult& r, const LayerParams& L, const Violation& violation) {
   r.thickness_min = 1e300, r.thickness_max = 0;
   const double tan_max = std::tan((L.max_angle_deg + 0.5) * M_PI / 180.0);
   for (std::size_t li = 0; li < r.layers.size(); ++li)
@@ -95,13 +68,22 @@ Expected<bool> gate(SliceResult& r, const SliceJob& job, const layers::BandedFie
       }
     }
   if (r.thickness_min > r.thickness_max) r.thickness_min = r.thickness_max = 0;
+  return true;
+}
+
+}  // namespace
+
+Expected<bool> gate(SliceResult& r, const SliceJob& job, const layers::BandedField* banded,
+                    const Violation& violation, const Context& ctx) {
+  if (!limits(r, job.layers, violation)) return false;
   if (!r.nonplanar) return true;  // planar layers cannot dig into earlier ones
-  // Collisions are looked for even when bands already broke a limit, so one retry drops
-  // every offender (each retry replans, reslices and rechecks the whole part).
-  CheckParams cp = job.check;
+  // Collisions: in the program about to be written, read back as `check` reads the file, so
+  // the two agree to the last digit. They are looked for even when bands already broke a
+  // limit, so one retry drops every offender (each retry replans, reslices and rechecks).
+  if (auto w = write_program(r, job, ctx); !w) return w.error();
   // Only where a curved layer is within the head's reach (gate_zones.hpp): on the bunny that
   // skipped most of 24 million extrusion samples.
-  GateZones zones = banded ? gate_zones(*banded, cp.toolhead.reach()) : GateZones{};
+  GateZones zones = banded ? gate_zones(*banded, job.check.toolhead.reach()) : GateZones{};
   zones.find_last_layers(r.layers);
   std::function<bool(const Vec3&)> looked_at;
   if (!zones.query.empty())
@@ -109,11 +91,10 @@ Expected<bool> gate(SliceResult& r, const SliceJob& job, const layers::BandedFie
       return std::any_of(zones.query.begin(), zones.query.end(),
                          [&](const BoundingBox& b) { return b.contains(p); });
     };
-  auto figures = find_collisions(moves_from_toolpaths(r.layers, job.print.gcode,
-                                                      [&](const ExtrusionPath& p, int li) {
-                                                        return !banded || zones.may_matter(p, li);
-                                                      }),
-                                 cp, looked_at, ctx);
+  auto figures = find_collisions(
+      read_print_moves(r.gcode,
+                       [&](const GcodeMove& m) { return !banded || zones.may_matter(m, m.layer); }),
+      job.check, looked_at, ctx);
   if (!figures) return figures.error();
   r.collisions = figures->collisions;
   if (figures->collisions > 0)

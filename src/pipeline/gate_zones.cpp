@@ -38,6 +38,14 @@ bool GateZones::may_matter(const ExtrusionPath& p, int layer) const {
   return false;
 }
 
+bool GateZones::may_matter(const GcodeMove& m, int layer) const {
+  const BoundingBox mb{m.from.cwiseMin(m.to), m.from.cwiseMax(m.to)};
+  for (std::size_t b = 0; b < material.size(); ++b)
+    if ((b >= last_layer.size() || layer <= last_layer[b]) && mb.intersects(material[b]))
+      return true;
+  return false;
+}
+
 GateZones gate_zones(const layers::BandedField& field, double R) {
   GateZones g;
   for (std::size_t n = 0; n < field.bands().size(); ++n) {

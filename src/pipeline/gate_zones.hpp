@@ -8,6 +8,7 @@
 
 #include "layers/banded_field.hpp"
 #include "nonplanar/mesh.hpp"
+#include "nonplanar/program.hpp"
 #include "nonplanar/toolpaths.hpp"
 
 namespace nonplanar {
@@ -16,7 +17,7 @@ namespace nonplanar {
 /// S_0 + L_rec (BandedField::reach). Two planar layers cannot collide (earlier material lies a
 /// layer below the nozzle), so a collision needs a curved layer within R of the nozzle:
 /// - `query`: per band, its support grown by R, from c up to above its top: no extrusion
-///   point outside every such box can collide (CheckParams::collision_zones);
+///   point outside every such box can collide (find_collisions' looked_at);
 /// - `material`: per band, its support grown by 2R, from c up, and no later than the last
 ///   layer with a point in its query box: the only material a query point can meet (it
 ///   must be of an earlier layer). Every box has 1 mm of slack on each side.
@@ -28,6 +29,8 @@ struct GateZones {
   /// Can this path of layer `layer` matter to the gate (meet a material box, no later than
   /// its last layer)?
   bool may_matter(const ExtrusionPath& p, int layer) const;
+  /// The same for one move of the program (its segment's box).
+  bool may_matter(const GcodeMove& m, int layer) const;
 };
 
 /// The zones of every band of `field`; R in mm.

@@ -7,8 +7,6 @@
 #include <optional>
 
 #include "engine/engine_route.hpp"
-#include "engine/shell_engine.hpp"
-#include "engine/shell_toolpaths.hpp"
 #include "layers/banded_field.hpp"
 #include "nonplanar/deform.hpp"
 #include "nonplanar/pipeline.hpp"
@@ -144,20 +142,14 @@ Expected<std::optional<SliceResult>> try_shell(const TriangleMesh& mesh, const S
   }
   SliceResult r;
   const EngineRoute route{job.engine, job.print, job.layers, job.map_back};
-  if (job.engine.engine == Engine::builtin) {
-    auto paths = shell_toolpaths(mesh, plan, job.print, ctx);
-    if (!paths) return paths.error();
-    r.layers = std::move(*paths);
-  } else {
-    auto printed = shell_with_engine(mesh, plan, route, ctx);
-    if (!printed && printed.error().status == Status::unsupported) {
-      planar.notices.push_back(name + " not printed as a shell: " + printed.error().message);
-      return std::optional<SliceResult>{};
-    }
-    if (!printed) return printed.error();
-    r.layers = std::move(printed->layers);
-    r.gcode = std::move(printed->gcode);
+  auto printed = shell_with(mesh, plan, route, ctx);
+  if (!printed && printed.error().status == Status::unsupported) {
+    planar.notices.push_back(name + " not printed as a shell: " + printed.error().message);
+    return std::optional<SliceResult>{};
   }
+  if (!printed) return printed.error();
+  r.layers = std::move(printed->layers);
+  r.gcode = std::move(printed->gcode);
   r.header = planar.header;
   char buf[200];
   std::snprintf(buf, sizeof buf,
@@ -259,6 +251,7 @@ Expected<SliceResult> slice_model(const TriangleMesh& mesh, const SliceJob& job,
   auto r = slice_rounds(mesh, job, ctx);
   if (!r) return r;
   if (auto e = nothing_to_print(*r, mesh)) return *e;
+  if (auto w = write_program(*r, job, ctx); !w) return w.error();
   r->notices.insert(r->notices.begin(), job.notices.begin(), job.notices.end());
   return r;
 }

@@ -47,12 +47,27 @@ bool is_m_number(std::string_view n) {
                                        : digits(n.substr(0, dot)) && digits(n.substr(dot + 1));
 }
 
+// Calls f(i, line) for each line of text (without its line end), i from 0.
+template <class F>
+void for_each_line(std::string_view text, F&& f) {
+  std::size_t i = 0;
+  for (std::size_t start = 0; start < text.size(); ++i) {
+    std::size_t end = text.find('\n', start);
+    if (end == std::string_view::npos) end = text.size();
+    std::string_view l = text.substr(start, end - start);
+    if (!l.empty() && l.back() == '\r') l.remove_suffix(1);
+    f(i, l);
+    start = end + 1;
+  }
+}
+
+// Reads a whole text into p, or, with a sink, hands every move to it and keeps no lines or
+// moves (p then holds the problems and the per-file figures only).
 class Reader {
  public:
-  explicit Reader(GcodeProgram& p) : p_(p) {}
-  void split(std::string_view text);
-  void find_print();
-  void read_line(std::size_t i);
+  using Sink = std::function<void(const GcodeMove&)>;
+  Reader(GcodeProgram& p, const Sink* sink) : p_(p), sink_(sink) {}
+  void run(std::string_view text);
 
  private:
   void comment(std::string_view c, std::size_t semi, GcodeLine& item, bool in_print);
@@ -63,7 +78,12 @@ class Reader {
     p_.problems.push_back({line_, std::move(why), moves_head});
   }
 
+  void find_print(std::string_view text);
+  void read_line(std::size_t i, GcodeLine& item);
+
   GcodeProgram& p_;
+  const Sink* sink_;
+  std::size_t n_ = 0;  // lines in the file
   int line_ = 0;
   Vec3 pos_{0, 0, 0};
   GcodeState s_;
@@ -73,42 +93,43 @@ class Reader {
   int layer_ = -1;
 };
 
-void Reader::split(std::string_view text) {
-  for (std::size_t start = 0; start < text.size();) {
-    std::size_t end = text.find('\n', start);
-    if (end == std::string_view::npos) end = text.size();
-    std::string_view l = text.substr(start, end - start);
-    if (!l.empty() && l.back() == '\r') l.remove_suffix(1);
+void Reader::run(std::string_view text) {
+  find_print(text);
+  if (!sink_) p_.lines.reserve(n_);
+  for_each_line(text, [&](std::size_t i, std::string_view l) {
     GcodeLine item;
     item.raw = l;
-    p_.lines.push_back(item);
-    start = end + 1;
-  }
+    read_line(i, item);
+    if (!sink_) p_.lines.push_back(item);
+  });
 }
 
-void Reader::find_print() {
-  const std::size_t n = p_.lines.size();
-  std::size_t last_typed = 0;
-  p_.print_begin = p_.print_end = n;
-  for (std::size_t i = 0; i < n; ++i) {
-    const std::string_view l = p_.lines[i].raw;
-    if (p_.print_begin == n && l.rfind(";LAYER_CHANGE", 0) == 0) p_.print_begin = i;
-    if (l.rfind(";TYPE:", 0) == 0 && l.rfind(";TYPE:Custom", 0) != 0) last_typed = i;
-  }
-  if (p_.print_begin == n) return;
-  for (std::size_t i = std::max(last_typed, p_.print_begin); i < n; ++i)
-    if (p_.lines[i].raw.rfind(";TYPE:Custom", 0) == 0) {
+void Reader::find_print(std::string_view text) {
+  std::size_t last_typed = 0, begin = std::string_view::npos;
+  std::vector<std::size_t> custom;  // the ;TYPE:Custom lines
+  for_each_line(text, [&](std::size_t i, std::string_view l) {
+    n_ = i + 1;
+    if (begin == std::string_view::npos && l.rfind(";LAYER_CHANGE", 0) == 0) begin = i;
+    if (l.rfind(";TYPE:Custom", 0) == 0)
+      custom.push_back(i);
+    else if (l.rfind(";TYPE:", 0) == 0)
+      last_typed = i;
+  });
+  p_.print_begin = p_.print_end = n_;
+  if (begin == std::string_view::npos) return;
+  p_.print_begin = begin;
+  for (std::size_t i : custom)
+    if (i >= std::max(last_typed, begin)) {
       p_.print_end = i;
       break;
     }
 }
 
-void Reader::read_line(std::size_t i) {
+void Reader::read_line(std::size_t i, GcodeLine& item) {
   line_ = static_cast<int>(i) + 1;
   const bool in_print = p_.in_print(i);
   if (i == p_.print_begin) p_.at_print = s_;
   if (i == p_.print_end) p_.at_end = s_;
-  GcodeLine& item = p_.lines[i];
   std::string_view l = item.raw;
   const std::size_t semi = l.find(';');
   if (semi != std::string_view::npos) {
@@ -119,7 +140,7 @@ void Reader::read_line(std::size_t i) {
   core::Tokenizer tok(l);
   const std::string_view cmd = tok.next();
   if (!cmd.empty()) command(cmd, tok, item, i);
-  if (i + 1 == p_.lines.size() && p_.print_end == p_.lines.size()) p_.at_end = s_;
+  if (i + 1 == n_ && p_.print_end == n_) p_.at_end = s_;
 }
 
 void Reader::comment(std::string_view c, std::size_t semi, GcodeLine& item, bool in_print) {
@@ -255,34 +276,49 @@ void Reader::move(core::Tokenizer& tok, GcodeLine& item, bool in_print) {
   }
   m.wipe = wipe_, m.type = type_, m.width = width_, m.height = h_, m.layer = layer_;
   item.kind = Kind::move;
+  if (sink_) return (*sink_)(m);
   item.move = static_cast<int>(p_.moves.size());
   p_.moves.push_back(m);
+}
+
+PrintMove print_move(const GcodeMove& g) {
+  PrintMove m;
+  m.from = g.from, m.to = g.to, m.filament = g.de, m.extruding = g.extruding();
+  m.type = g.type, m.layer = g.layer, m.width = g.width, m.line = g.line;
+  return m;
 }
 
 }  // namespace
 
 GcodeProgram read_gcode_program(std::string_view text) {
   GcodeProgram p;
-  Reader r(p);
-  r.split(text);
-  r.find_print();
-  for (std::size_t i = 0; i < p.lines.size(); ++i) r.read_line(i);
+  Reader(p, nullptr).run(text);
   return p;
 }
 
+std::vector<GcodeProblem> for_each_gcode_move(std::string_view text,
+                                              const std::function<void(const GcodeMove&)>& f) {
+  GcodeProgram p;
+  Reader(p, &f).run(text);
+  return std::move(p.problems);
+}
+
+std::vector<PrintMove> read_print_moves(std::string_view text,
+                                        const std::function<bool(const GcodeMove&)>& keep) {
+  std::vector<PrintMove> moves;
+  for_each_gcode_move(text, [&](const GcodeMove& g) {
+    if (!keep || keep(g)) moves.push_back(print_move(g));
+  });
+  return moves;
+}
+
 Expected<std::vector<PrintMove>> read_gcode_moves(std::string_view text) {
-  const GcodeProgram p = read_gcode_program(text);
-  for (const GcodeProblem& q : p.problems)
+  std::vector<PrintMove> moves;
+  const auto problems =
+      for_each_gcode_move(text, [&](const GcodeMove& g) { moves.push_back(print_move(g)); });
+  for (const GcodeProblem& q : problems)
     if (!q.moves_head)
       return Error{Status::parse_error, "line " + std::to_string(q.line) + ": " + q.why};
-  std::vector<PrintMove> moves;
-  moves.reserve(p.moves.size());
-  for (const GcodeMove& g : p.moves) {
-    PrintMove m;
-    m.from = g.from, m.to = g.to, m.filament = g.de, m.extruding = g.extruding();
-    m.type = std::string(g.type), m.layer = g.layer, m.width = g.width, m.line = g.line;
-    moves.push_back(std::move(m));
-  }
   return moves;
 }
 

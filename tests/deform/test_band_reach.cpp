@@ -40,7 +40,6 @@ struct DomeOnSlab {
 
 TEST(GateZones, FindEveryCollisionTheFullCheckFinds) {
   const DomeOnSlab d;
-  const PrintConfig& c = d.c;
   const SliceResult* r = &d.r;
   ASSERT_EQ(r->plan.stacks.size(), 1u);
   const layers::BandedField* field = d.field;
@@ -50,15 +49,15 @@ TEST(GateZones, FindEveryCollisionTheFullCheckFinds) {
   CheckParams cp;
   cp.toolhead.block_clearance = 0.3;
   cp.toolhead.cone_angle_deg = 10;
-  const std::vector<PrintMove> all = moves_from_toolpaths(r->layers, c.gcode);
+  const std::vector<PrintMove> all = read_print_moves(r->gcode);
   auto full = find_collisions(all, cp, nullptr, {});
   ASSERT_TRUE(full);
 
   GateZones zones = gate_zones(*field, cp.toolhead.reach());
   zones.find_last_layers(r->layers);
   ASSERT_EQ(zones.query.size(), 1u);
-  const std::vector<PrintMove> near = moves_from_toolpaths(
-      r->layers, c.gcode, [&](const ExtrusionPath& p, int li) { return zones.may_matter(p, li); });
+  const std::vector<PrintMove> near =
+      read_print_moves(r->gcode, [&](const GcodeMove& m) { return zones.may_matter(m, m.layer); });
   auto in_zones = [&](const Vec3& p) {
     return std::any_of(zones.query.begin(), zones.query.end(),
                        [&](const BoundingBox& b) { return b.contains(p); });
