@@ -8,6 +8,7 @@
 
 #include "deform/map_segment.hpp"
 #include "nonplanar/deform.hpp"
+#include "program/layer_passes.hpp"
 
 namespace nonplanar {
 
@@ -45,6 +46,37 @@ namespace {
 
 bool is_top(const ExtrusionPath& p) {
   return p.role == ExtrusionRole::top_solid_infill;
+}
+
+// Each run of top-skin paths, in the order and direction the rule gives.
+void order_top_skins(std::vector<ExtrusionPath>& ps) {
+  for (std::size_t s = 0; s < ps.size();) {
+    if (!is_top(ps[s])) {
+      ++s;
+      continue;
+    }
+    std::size_t e = s;
+    while (e < ps.size() && is_top(ps[e])) ++e;
+    std::vector<program::StrokeHeights> h;
+    for (std::size_t k = s; k < e; ++k) {
+      program::StrokeHeights sh;
+      for (const Vec3& v : ps[k].points) sh.mean += v.z();
+      sh.mean /= static_cast<double>(ps[k].points.size());
+      sh.first = ps[k].points.front().z(), sh.last = ps[k].points.back().z();
+      h.push_back(sh);
+    }
+    const program::LowToHigh order = program::low_to_high(h);
+    std::vector<ExtrusionPath> run;
+    for (std::size_t k : order.order) {
+      run.push_back(std::move(ps[s + k]));
+      if (order.reverse[k]) {
+        std::reverse(run.back().points.begin(), run.back().points.end());
+        std::reverse(run.back().height.begin(), run.back().height.end());
+      }
+    }
+    std::move(run.begin(), run.end(), ps.begin() + static_cast<long>(s));
+    s = e;
+  }
 }
 
 }  // namespace
@@ -89,34 +121,8 @@ Expected<std::vector<LayerToolpaths>> map_toolpaths_back(const std::vector<Layer
     }
     M.nonplanar = M.max_z - min_z > 1e-6;
     if (M.paths.empty()) M.max_z = L.z;
-    // Top skins on a slope, low to high: a line printed beside a higher line of the same
-    // layer would drag the nozzle's flat through it (DESIGN.md §3). Each run of top-skin
-    // lines is sorted by height and every line starts at its low end.
-    if (M.nonplanar) {
-      auto& ps = M.paths;
-      for (std::size_t s = 0; s < ps.size();) {
-        if (!is_top(ps[s])) {
-          ++s;
-          continue;
-        }
-        std::size_t e = s;
-        while (e < ps.size() && is_top(ps[e])) ++e;
-        for (std::size_t k = s; k < e; ++k)
-          if (ps[k].points.front().z() > ps[k].points.back().z()) {
-            std::reverse(ps[k].points.begin(), ps[k].points.end());
-            std::reverse(ps[k].height.begin(), ps[k].height.end());
-          }
-        auto mean_z = [](const ExtrusionPath& p) {
-          double z = 0;
-          for (const Vec3& v : p.points) z += v.z();
-          return z / static_cast<double>(p.points.size());
-        };
-        std::stable_sort(
-            ps.begin() + static_cast<long>(s), ps.begin() + static_cast<long>(e),
-            [&](const ExtrusionPath& a, const ExtrusionPath& b) { return mean_z(a) < mean_z(b); });
-        s = e;
-      }
-    }
+    // Top skins on a slope, low to high (program::low_to_high, DESIGN.md §3).
+    if (M.nonplanar) order_top_skins(M.paths);
   });
   if (stop) return Error{Status::cancelled, "cancelled"};
   return out;

@@ -22,6 +22,21 @@ struct LayerWork {
   GcodeLine add(GcodeMove m, ExtrusionPath p = {});
 };
 
+/// One stroke of a top skin, as the low-to-high rule sees it: its mean height and the heights
+/// of its two ends (mm).
+struct StrokeHeights {
+  double mean = 0, first = 0, last = 0;
+};
+
+/// The rule of DESIGN.md §3 for one run of top-skin strokes: they print by mean height, lowest
+/// first (stable), each from its low end. Output: the order (indices into `strokes`), and for
+/// each stroke whether it is to be printed backwards.
+struct LowToHigh {
+  std::vector<std::size_t> order;
+  std::vector<char> reverse;
+};
+LowToHigh low_to_high(const std::vector<StrokeHeights>& strokes);
+
 /// Top skins on a slope, low to high (DESIGN.md §3: a line printed beside a higher line of
 /// the same layer drags the nozzle's flat through it). In each run of "Top solid infill" the
 /// strokes (unbroken extrusions) are sorted by mean mapped height and each starts at its low

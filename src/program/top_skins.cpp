@@ -16,6 +16,17 @@ GcodeLine LayerWork::add(GcodeMove m, ExtrusionPath p) {
   return it;
 }
 
+LowToHigh low_to_high(const std::vector<StrokeHeights>& strokes) {
+  LowToHigh r;
+  r.order.resize(strokes.size());
+  r.reverse.resize(strokes.size());
+  for (std::size_t i = 0; i < strokes.size(); ++i)
+    r.order[i] = i, r.reverse[i] = strokes[i].first > strokes[i].last + 1e-9;
+  std::stable_sort(r.order.begin(), r.order.end(),
+                   [&](std::size_t a, std::size_t b) { return strokes[a].mean < strokes[b].mean; });
+  return r;
+}
+
 namespace {
 
 using Kind = GcodeLine::Kind;
@@ -77,10 +88,8 @@ Run collect_run(LayerWork& w, std::size_t s, std::size_t e) {
 
 // The travel from prev to the start of `stroke` (low end first), retracted around when over
 // 1 mm, then the stroke; appended to out. Returns where the stroke ends.
-Vec3 write_stroke(LayerWork& w, const Run& r, const std::vector<int>& stroke, const Vec3& prev,
-                  std::vector<GcodeLine>& out) {
-  const bool reverse = w.mapped[static_cast<std::size_t>(stroke.front())].points.front().z() >
-                       w.mapped[static_cast<std::size_t>(stroke.back())].points.back().z() + 1e-9;
+Vec3 write_stroke(LayerWork& w, const Run& r, const std::vector<int>& stroke, bool reverse,
+                  const Vec3& prev, std::vector<GcodeLine>& out) {
   GcodeMove travel = w.moves[static_cast<std::size_t>(reverse ? stroke.back() : stroke.front())];
   const Vec3 start = reverse ? travel.to : travel.from;
   travel.from = prev, travel.to = start, travel.has_xy = true, travel.has_z = false;
@@ -115,12 +124,15 @@ Vec3 write_stroke(LayerWork& w, const Run& r, const std::vector<int>& stroke, co
 }  // namespace
 
 void order_top_skins(LayerWork& w) {
-  auto mean_z = [&](const std::vector<int>& stroke) {
-    double z = 0;
+  auto heights = [&](const std::vector<int>& stroke) {
+    StrokeHeights h;
     std::size_t n = 0;
     for (int m : stroke)
-      for (const Vec3& v : w.mapped[static_cast<std::size_t>(m)].points) z += v.z(), ++n;
-    return n ? z / static_cast<double>(n) : 0.0;
+      for (const Vec3& v : w.mapped[static_cast<std::size_t>(m)].points) h.mean += v.z(), ++n;
+    h.mean = n ? h.mean / static_cast<double>(n) : 0.0;
+    h.first = w.mapped[static_cast<std::size_t>(stroke.front())].points.front().z();
+    h.last = w.mapped[static_cast<std::size_t>(stroke.back())].points.back().z();
+    return h;
   };
   std::vector<GcodeLine>& seq = w.lines;
   for (std::size_t s = 0; s < seq.size(); ++s) {
@@ -129,12 +141,14 @@ void order_top_skins(LayerWork& w) {
     while (e < seq.size() && !is_type(seq[e], ";TYPE:")) ++e;
     Run r = collect_run(w, s, e);
     if (r.strokes.empty()) continue;
-    std::stable_sort(r.strokes.begin(), r.strokes.end(),
-                     [&](const auto& a, const auto& b) { return mean_z(a) < mean_z(b); });
+    std::vector<StrokeHeights> h;
+    for (const auto& stroke : r.strokes) h.push_back(heights(stroke));
+    const LowToHigh order = low_to_high(h);
     std::vector<GcodeLine> out{seq[s]};
     out.insert(out.end(), r.head.begin(), r.head.end());
-    Vec3 prev = w.moves[static_cast<std::size_t>(r.strokes.front().front())].from;
-    for (const auto& stroke : r.strokes) prev = write_stroke(w, r, stroke, prev, out);
+    Vec3 prev = w.moves[static_cast<std::size_t>(r.strokes[order.order[0]].front())].from;
+    for (std::size_t k : order.order)
+      prev = write_stroke(w, r, r.strokes[k], order.reverse[k] != 0, prev, out);
     out.insert(out.end(), r.tail.begin(), r.tail.end());
     seq.erase(seq.begin() + static_cast<long>(s), seq.begin() + static_cast<long>(e));
     seq.insert(seq.begin() + static_cast<long>(s), out.begin(), out.end());
