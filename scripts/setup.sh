@@ -14,7 +14,7 @@ set -euo pipefail
 pkgs=(
   build-essential cmake ninja-build pkg-config
   libeigen3-dev libceres-dev libtbb-dev libpolyclipping-dev lib3mf-dev
-  libcli11-dev nlohmann-json3-dev libfmt-dev libspdlog-dev
+  libcli11-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   zip unzip time
 )

@@ -54,7 +54,7 @@ int run(const LayersOptions& o) {
   if (!job) return report_error(job.error());
   const LayerParams& lp = job->layers;
   if (!o.mesh.quiet && !o.json)
-    for (const std::string& n : job->notices) std::fprintf(stderr, "notice: %s\n", n.c_str());
+    for (const Notice& n : job->notices) std::fprintf(stderr, "notice: %s\n", n.text.c_str());
   char axis = 0;
   double at = 0;
   if (!o.section.empty()) {

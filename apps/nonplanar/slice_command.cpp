@@ -102,7 +102,7 @@ int run(const SliceOptions& o) {
   if (!w) return report_error(w.error());
   report_warnings(o.mesh.model, *loaded, o.mesh.quiet);
   if (!o.mesh.quiet) {
-    for (const auto& n : result->notices) std::fprintf(stderr, "notice: %s\n", n.c_str());
+    for (const auto& n : result->notices) std::fprintf(stderr, "notice: %s\n", n.text.c_str());
     char curved[80];
     if (result->shell_layers > 0)
       std::snprintf(curved, sizeof curved, "a curved shell of %d layers", result->shell_layers);

@@ -13,13 +13,27 @@
 
 namespace nonplanar {
 
+/// One line the pipeline has for the user, about one patch or the whole part.
+struct Notice {
+  enum class Kind {
+    setting,       ///< a setting was adapted to the printer (make_job)
+    patch_planar,  ///< the patch prints planar, and why
+    none_needed,   ///< no surface needs curved layers: the part slices planar
+    none_fit,      ///< no patch could get a stack (a shell may still print it)
+    shell,         ///< about a shell: printed, or refused and why
+  };
+  Kind kind = Kind::setting;
+  int patch = -1;    ///< the patch it is about (-1: the part, or several patches)
+  std::string text;  ///< the line as printed, e.g. "patch 3 printed planar: ..."
+};
+
 struct SliceJob {
   AnalysisParams analysis;
   FitParams fit;
-  LayerParams layers;      ///< layer heights and printer limits; set from print by make_job
-  MapBackParams map_back;  ///< mapping paths and another engine's G-code back; by make_job
-  CheckParams check;       ///< the safety gate's limits and head; set by make_job
-  std::vector<std::string> notices;  ///< what make_job adapted (passed on to the result)
+  LayerParams layers;           ///< layer heights and printer limits; set from print by make_job
+  MapBackParams map_back;       ///< mapping paths and another engine's G-code back; by make_job
+  CheckParams check;            ///< the safety gate's limits and head; set by make_job
+  std::vector<Notice> notices;  ///< what make_job adapted (passed on to the result)
   PrintConfig print;
   bool planar_only = false;
   /// Another slicer instead of the built-in engine: it slices the normalised mesh with the
@@ -38,8 +52,8 @@ SliceJob make_job(const PrintConfig& print, double max_angle_deg = 30.0);
 struct SliceResult {
   std::vector<LayerToolpaths> layers;
   LayerPlan plan;
-  std::vector<std::string> notices;  ///< one line each (fallbacks, planar because ...)
-  std::vector<std::string> header;   ///< for the G-code's header comment
+  std::vector<Notice> notices;      ///< fallbacks, planar because ..., shells; in order
+  std::vector<std::string> header;  ///< for the G-code's header comment
   double thickness_min = 0, thickness_max = 0, steepest_deg = 0;
   std::size_t collisions = 0;
   bool nonplanar = false;

@@ -32,7 +32,7 @@ SliceJob make_job(const PrintConfig& print, double max_angle_deg) {
                   "max_angle lowered from %.1f to %.1f deg: the nozzle's cone "
                   "(nozzle_cone_angle) is no steeper",
                   max_angle_deg, cone);
-    j.notices.emplace_back(buf);
+    j.notices.push_back({Notice::Kind::setting, -1, buf});
     j.analysis.max_angle_deg = j.layers.max_angle_deg = cone;
   }
   j.layers.toolhead = print.toolhead;

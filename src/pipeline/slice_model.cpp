@@ -16,6 +16,11 @@ namespace nonplanar {
 
 namespace {
 
+Notice planar_notice(int patch, const std::string& why) {
+  return {Notice::Kind::patch_planar, patch,
+          "patch " + std::to_string(patch) + " printed planar: " + why};
+}
+
 // One attempt with the patches not in `excluded`. When no stack can be built and `deferred` is
 // given, it is set and the result is returned unsliced (the caller tries a shell first). On a limit
 // violation inside a curved band, every such band's patch and what it broke are added to *offenders
@@ -57,13 +62,15 @@ Expected<SliceResult> attempt(const TriangleMesh& mesh, const SliceJob& job, con
     auto plan = plan_layers(mesh, *a, fits, ids, job.layers, pre.stacks, ctx);
     if (!plan) return plan.error();
     r.plan = std::move(*plan);
-    for (const auto& fb : r.plan.fallbacks)
-      r.notices.push_back("patch " + std::to_string(fb.patch) + " printed planar: " + fb.reason);
+    for (const auto& fb : r.plan.fallbacks) r.notices.push_back(planar_notice(fb.patch, fb.reason));
     if (r.plan.stacks.empty()) {
       std::size_t candidates = 0;
       for (const Patch& p : a->patches) candidates += p.needs_nonplanar();
-      r.notices.push_back(candidates == 0 ? "no surface needs non-planar layers; slicing planar"
-                                          : "no patch can be printed non-planar; slicing planar");
+      r.notices.push_back(candidates == 0
+                              ? Notice{Notice::Kind::none_needed, -1,
+                                       "no surface needs non-planar layers; slicing planar"}
+                              : Notice{Notice::Kind::none_fit, -1,
+                                       "no patch can be printed non-planar; slicing planar"});
       // The caller may print it as a shell instead (try_shell): slice planar only if not.
       if (deferred && candidates > 0) return *deferred = true, r;
     } else {
@@ -135,16 +142,18 @@ Expected<std::optional<SliceResult>> try_shell(const TriangleMesh& mesh, const S
   if (plan.patches.size() > 1) name += "es";
   for (std::size_t k = 0; k < plan.patches.size(); ++k)
     name += (k ? ", " : " ") + std::to_string(plan.patches[k]);
+  auto refused = [&](const std::string& why) {
+    return Notice{Notice::Kind::shell, -1, name + " not printed as a shell: " + why};
+  };
   if (!plan.refused.empty()) {
-    if (plan.refused != layers::kNotOnTop)
-      planar.notices.push_back(name + " not printed as a shell: " + plan.refused);
+    if (plan.refused != layers::kNotOnTop) planar.notices.push_back(refused(plan.refused));
     return std::optional<SliceResult>{};
   }
   SliceResult r;
   const EngineRoute route{job.engine, job.print, job.layers, job.map_back};
   auto printed = shell_with(mesh, plan, route, ctx);
   if (!printed && printed.error().status == Status::unsupported) {
-    planar.notices.push_back(name + " not printed as a shell: " + printed.error().message);
+    planar.notices.push_back(refused(printed.error().message));
     return std::optional<SliceResult>{};
   }
   if (!printed) return printed.error();
@@ -156,13 +165,15 @@ Expected<std::optional<SliceResult>> try_shell(const TriangleMesh& mesh, const S
                 "%s: a shell of %d curved layers of %.2f mm over %zu planar core layers",
                 name.c_str(), plan.N, plan.t, plan.core.size() - 1);
   r.header.push_back(buf);
-  for (const std::string& n : planar.notices) {
-    const bool about_shell = std::any_of(plan.patches.begin(), plan.patches.end(), [&](int i) {
-      return n.rfind("patch " + std::to_string(i) + " ", 0) == 0;
-    });
-    if (!about_shell && n.rfind("no patch can", 0) != 0) r.notices.push_back(n);
+  // What the planar attempt said of the shell's patches, and that no patch fits, is moot now.
+  for (const Notice& n : planar.notices) {
+    const bool about_shell =
+        n.kind == Notice::Kind::patch_planar &&
+        std::find(plan.patches.begin(), plan.patches.end(), n.patch) != plan.patches.end();
+    if (!about_shell && n.kind != Notice::Kind::none_fit) r.notices.push_back(n);
   }
-  r.notices.push_back(name + ": curved shell over a planar core (no stack over a plane fits it)");
+  r.notices.push_back({Notice::Kind::shell, -1,
+                       name + ": curved shell over a planar core (no stack over a plane fits it)"});
   if (!r.gcode.empty()) r.gcode = engine_header(route, r.header, plan.core.at(1)) + r.gcode;
   r.nonplanar = true;
   r.shell_layers = plan.N;
@@ -178,7 +189,7 @@ Expected<std::optional<SliceResult>> try_shell(const TriangleMesh& mesh, const S
       ctx);
   if (!ok) return ok.error();
   if (!*ok) {
-    planar.notices.push_back(name + " not printed as a shell: " + breach);
+    planar.notices.push_back(refused(breach));
     return std::optional<SliceResult>{};
   }
   return std::optional<SliceResult>(std::move(r));
@@ -201,7 +212,7 @@ Expected<SliceResult> slice_rounds(const TriangleMesh& mesh, const SliceJob& job
     pre.fits = std::move(*fits);
   }
   std::vector<int> excluded;
-  std::vector<std::string> dropped;
+  std::vector<Notice> dropped;
   std::vector<std::pair<int, std::string>> offenders;
   for (int round = 0; round < 8; ++round) {
     // OrcaSlicer prints no shells (its command line cannot take our layer boundaries): with
@@ -216,7 +227,7 @@ Expected<SliceResult> slice_rounds(const TriangleMesh& mesh, const SliceJob& job
       auto shell = try_shell(mesh, job, pre.analysis, *r, ctx);
       if (!shell) return shell.error();
       if (*shell) return std::move(**shell);
-      const std::vector<std::string> notices = std::move(r->notices);
+      const std::vector<Notice> notices = std::move(r->notices);
       r = attempt(mesh, job, pre, excluded, &offenders, nullptr, ctx);
       if (!r) return r;
       r->notices = notices;
@@ -233,12 +244,11 @@ Expected<SliceResult> slice_rounds(const TriangleMesh& mesh, const SliceJob& job
     // costs a whole attempt, and on the bunny both comebacks (patches 5 and 13) then collided.
     for (const PlanarFallback& fb : r->plan.fallbacks) {
       excluded.push_back(fb.patch);
-      dropped.push_back("patch " + std::to_string(fb.patch) + " printed planar: " + fb.reason);
+      dropped.push_back(planar_notice(fb.patch, fb.reason));
     }
     for (const auto& [patch, why] : offenders) {
       excluded.push_back(patch);
-      dropped.push_back("patch " + std::to_string(patch) + " printed planar: in its final paths " +
-                        why);
+      dropped.push_back(planar_notice(patch, "in its final paths " + why));
     }
   }
   return Error{Status::internal_error, "safety check: still failing after dropping 8 patches"};

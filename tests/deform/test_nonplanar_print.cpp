@@ -167,7 +167,7 @@ TEST(NonplanarPrint, RibTopFromNearTheBedPrintsAsAShell) {
   EXPECT_LE(o.figures.deviation_p95, 0.005);
   EXPECT_NEAR(o.figures.volume_ratio, 1.0, 0.03);
   ASSERT_FALSE(o.result.notices.empty());
-  EXPECT_NE(o.result.notices.back().find("curved shell"), std::string::npos);
+  EXPECT_NE(o.result.notices.back().text.find("curved shell"), std::string::npos);
 }
 
 // The CurviSlicer wing: its top runs from the bed at the nose to 17.5 mm; its windows' floors
@@ -187,7 +187,7 @@ TEST(NonplanarPrint, FlatTopsSlicePlanarWithANotice) {
   const Outcome o = run(test::box({0, 0, 0}, {20, 20, 10}));
   EXPECT_FALSE(o.result.nonplanar);
   ASSERT_FALSE(o.result.notices.empty());
-  EXPECT_NE(o.result.notices.back().find("slicing planar"), std::string::npos);
+  EXPECT_NE(o.result.notices.back().text.find("slicing planar"), std::string::npos);
   EXPECT_NEAR(o.figures.steepest_deg, 0.0, 1e-9);
 }
 
