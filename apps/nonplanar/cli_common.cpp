@@ -191,8 +191,8 @@ void add_analysis_options(CLI::App& cmd, AnalysisParams& p) {
       ->capture_default_str();
 }
 
-Expected<bool> check_max_angle(double max_angle_deg) {
-  if (max_angle_deg > 0 && max_angle_deg < 90) return true;
+Expected<void> check_max_angle(double max_angle_deg) {
+  if (max_angle_deg > 0 && max_angle_deg < 90) return {};
   return Error{Status::invalid_argument, "max_angle: must be in (0, 90) degrees"};
 }
 
@@ -209,7 +209,7 @@ bool same_file(const std::string& a, const std::string& b) {
 }
 }  // namespace
 
-Expected<bool> check_outputs(const std::vector<std::string>& inputs,
+Expected<void> check_outputs(const std::vector<std::string>& inputs,
                              const std::vector<std::string>& outputs) {
   for (std::size_t i = 0; i < outputs.size(); ++i) {
     if (outputs[i].empty()) continue;
@@ -222,7 +222,7 @@ Expected<bool> check_outputs(const std::vector<std::string>& inputs,
         return Error{Status::invalid_argument,
                      outputs[i] + ": is also " + outputs[j] + "; two outputs cannot share a file"};
   }
-  return true;
+  return {};
 }
 
 bool flush_stdout() {

@@ -65,7 +65,7 @@ struct ProfileOptions {
 };
 
 /// max_angle in (0, 90) degrees (NaN refused), or the error every subcommand gives.
-Expected<bool> check_max_angle(double max_angle_deg);
+Expected<void> check_max_angle(double max_angle_deg);
 
 /// One "KEY=VALUE" override; `known` is false for a key our settings do not have.
 struct Setting {
@@ -82,7 +82,7 @@ void add_analysis_options(CLI::App& cmd, AnalysisParams& p);
 
 /// Refuses to write any output over an input or over another output (the same file by any
 /// name: a link, "./x", an absolute path). Empty names are ignored. The error names both.
-Expected<bool> check_outputs(const std::vector<std::string>& inputs,
+Expected<void> check_outputs(const std::vector<std::string>& inputs,
                              const std::vector<std::string>& outputs);
 
 /// Flushes stdout; false (after printing "error: stdout: REASON") when what was printed did

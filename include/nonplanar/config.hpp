@@ -119,7 +119,7 @@ Expected<std::vector<ToolheadSlice>> load_toolhead_shape(const std::string& file
 bool is_nonplanar_key(const std::string& key);
 
 /// Checks ranges (finite, positive heights, density in [0, 1], ...). Error names the key.
-Expected<bool> validate_config(const PrintConfig& c);
+Expected<void> validate_config(const PrintConfig& c);
 
 /// Loads a JSON profile ({"layer_height": 0.2, ...}, keys as above) or a PrusaSlicer .ini
 /// (key = value lines) over `base` (the defaults, or the profiles loaded before it: a

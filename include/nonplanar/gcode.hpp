@@ -22,7 +22,7 @@ double filament_per_mm(double width, double height, const GcodeParams& g);
 /// macro it cannot fill in ("{max_layer_z}", "[printer_model]", "{if …}"), outside comments;
 /// a move off the bed; a line over 255 characters, or with a control byte, or a non-ASCII
 /// byte outside its comment. Error: invalid_argument naming the key, the line and the bed.
-Expected<bool> check_custom_gcode(const PrintConfig& c);
+Expected<void> check_custom_gcode(const PrintConfig& c);
 
 /// The whole program as text. Refuses (invalid_argument) a program that would leave the bed
 /// (a skirt too wide, a part placed at the edge), and what check_custom_gcode refuses. `header`
@@ -31,12 +31,12 @@ Expected<std::string> make_gcode(const std::vector<LayerToolpaths>& layers, cons
                                  const std::vector<std::string>& header, const Context& ctx);
 
 /// make_gcode into a file, atomically (temporary file, then rename).
-Expected<bool> write_gcode_file(const std::filesystem::path& file,
+Expected<void> write_gcode_file(const std::filesystem::path& file,
                                 const std::vector<LayerToolpaths>& layers, const PrintConfig& c,
                                 const std::vector<std::string>& header, const Context& ctx);
 
 /// A whole program already made (another engine's, mapped) into a file, atomically.
-Expected<bool> write_gcode_text(const std::filesystem::path& file, const std::string& text,
+Expected<void> write_gcode_text(const std::filesystem::path& file, const std::string& text,
                                 const Context& ctx);
 
 }  // namespace nonplanar

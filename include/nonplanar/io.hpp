@@ -45,7 +45,7 @@ Expected<LoadedMesh> load_mesh(const std::filesystem::path& file, const LoadPara
                                const Context& ctx);
 
 /// Binary STL writer (used by tests, benchmarks and later stages). Atomic.
-Expected<bool> write_stl(const std::filesystem::path& file, const TriangleMesh& mesh);
+Expected<void> write_stl(const std::filesystem::path& file, const TriangleMesh& mesh);
 
 /// A file stored beside the model in a 3MF package: its path in the package ("/Metadata/…")
 /// and its bytes.
@@ -55,11 +55,11 @@ struct PackageFile {
 
 /// 3MF writer: one mesh object, one build item with no transform, and `extra` files (e.g.
 /// PrusaSlicer's layer-height profile). Atomic.
-Expected<bool> write_3mf(const std::filesystem::path& file, const TriangleMesh& mesh,
+Expected<void> write_3mf(const std::filesystem::path& file, const TriangleMesh& mesh,
                          const std::vector<PackageFile>& extra = {});
 
 /// ASCII PLY with one RGB colour per face (face_colors: F entries, 0xRRGGBB). Atomic.
-Expected<bool> write_ply_face_colors(const std::filesystem::path& file, const TriangleMesh& mesh,
+Expected<void> write_ply_face_colors(const std::filesystem::path& file, const TriangleMesh& mesh,
                                      const std::vector<unsigned>& face_colors);
 
 }  // namespace nonplanar

@@ -147,7 +147,7 @@ class LayerField {
 /// A vertical cross-section of the part as SVG: the part's outline, every layer boundary
 /// inside the material (curved ones highlighted), axes in mm. axis 'x' cuts the plane
 /// x = value (the picture's horizontal axis is then y); 'y' cuts y = value. Atomic.
-Expected<bool> write_section_svg(const std::filesystem::path& file, const TriangleMesh& mesh,
+Expected<void> write_section_svg(const std::filesystem::path& file, const TriangleMesh& mesh,
                                  const LayerPlan& plan, char axis, double value);
 
 /// What `slice` prints when plan_layers builds no stack but the part's whole top is curved: a

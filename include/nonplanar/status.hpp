@@ -2,6 +2,7 @@
 // Errors are values, never exit() or an exception escaping the library.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <utility>
 #include <variant>
@@ -31,8 +32,9 @@ struct Error {
 };
 
 /// Either a value or an Error (std::expected is C++23; this is the small subset we need).
+/// [[nodiscard]]: a result nobody looks at is an error nobody sees.
 template <class T>
-class Expected {
+class [[nodiscard]] Expected {
  public:
   Expected(T value) : v_(std::move(value)) {}      // NOLINT: implicit on purpose
   Expected(Error error) : v_(std::move(error)) {}  // NOLINT
@@ -50,6 +52,20 @@ class Expected {
 
  private:
   std::variant<T, Error> v_;
+};
+
+/// Success or an Error, for an operation with no value to return.
+template <>
+class [[nodiscard]] Expected<void> {
+ public:
+  Expected() = default;
+  Expected(Error error) : e_(std::move(error)) {}  // NOLINT: implicit on purpose
+  bool ok() const { return !e_; }
+  explicit operator bool() const { return ok(); }
+  const Error& error() const { return *e_; }
+
+ private:
+  std::optional<Error> e_;
 };
 
 }  // namespace nonplanar

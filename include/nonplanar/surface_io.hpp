@@ -23,7 +23,7 @@ struct SurfaceRecord {
 
 /// Writes {"format": "nonplanar-surfaces", "version": 1, "units": "mm", "surfaces": [...]}.
 /// Atomic.
-Expected<bool> write_surfaces_json(const std::filesystem::path& file,
+Expected<void> write_surfaces_json(const std::filesystem::path& file,
                                    const std::vector<SurfaceRecord>& surfaces);
 
 /// Reads what write_surfaces_json wrote; every surface is checked with valid().
@@ -35,7 +35,7 @@ Expected<std::vector<SurfaceRecord>> parse_surfaces_json(std::string_view text);
 
 /// Each surface tessellated over its footprint rectangle as a `resolution`² grid of quads
 /// (two triangles each), one OBJ group per surface. Atomic.
-Expected<bool> write_surfaces_obj(const std::filesystem::path& file,
+Expected<void> write_surfaces_obj(const std::filesystem::path& file,
                                   const std::vector<SurfaceRecord>& surfaces, int resolution = 64);
 
 }  // namespace nonplanar

@@ -227,8 +227,8 @@ Expected<bool> set_value(PrintConfig& c, const std::string& key, const std::stri
       const auto x = item.find('x');
       const auto a =
           x == std::string::npos ? std::nullopt : core::parse_double(first_item(item.substr(0, x)));
-      const auto b =
-          x == std::string::npos ? std::nullopt : core::parse_double(first_item(item.substr(x + 1)));
+      const auto b = x == std::string::npos ? std::nullopt
+                                            : core::parse_double(first_item(item.substr(x + 1)));
       if (!a || !b) return bad(key, "'" + item + "' is not XxY");
       lo = lo.cwiseMin(Vec2(*a, *b));
       hi = hi.cwiseMax(Vec2(*a, *b));
@@ -268,7 +268,7 @@ bool is_nonplanar_key(const std::string& key) {
 
 // Ranges: wide enough for any real printer, narrow enough that every value formats into a
 // sane G-code line (travel_speed=1e10 once wrote F-2147483648, max_fan_speed=1000 M106 S2550).
-Expected<bool> validate_config(const PrintConfig& c) {
+Expected<void> validate_config(const PrintConfig& c) {
   auto in = [](double v, double lo, double hi) { return std::isfinite(v) && v >= lo && v <= hi; };
   auto pos = [](double v, double hi) { return std::isfinite(v) && v > 0 && v <= hi; };
   const ToolpathParams& t = c.paths;
@@ -342,7 +342,7 @@ Expected<bool> validate_config(const PrintConfig& c) {
     return bad("bed_shape", "is empty");
   if (c.bed_min.cwiseAbs().maxCoeff() > 1e5 || c.bed_max.cwiseAbs().maxCoeff() > 1e5)
     return bad("bed_shape", "corners must lie within 100 m of the origin");
-  return true;
+  return {};
 }
 
 Expected<PrintConfig> parse_ini_config(std::string_view text, PrintConfig c) {

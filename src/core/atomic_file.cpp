@@ -57,7 +57,7 @@ void remove_stale_temporaries(const std::filesystem::path& dir) {
 
 // Writes straight into what `file` is when it is not a regular file (a device such as
 // /dev/null or /dev/stdout, a pipe): renaming over it would replace the device node.
-Expected<bool> write_in_place(const std::filesystem::path& file,
+Expected<void> write_in_place(const std::filesystem::path& file,
                               const std::function<bool(std::ostream&)>& write) {
   std::ofstream out(file, std::ios::binary);
   if (!out)
@@ -67,7 +67,7 @@ Expected<bool> write_in_place(const std::filesystem::path& file,
   if (!ok)
     return Error{Status::io_error, file.string() + ": write failed" +
                                        (errno ? std::string(": ") + std::strerror(errno) : "")};
-  return true;
+  return {};
 }
 }  // namespace
 
@@ -75,7 +75,7 @@ void remove_pending_temporary_file() {
   if (g_pending_set.load()) ::unlink(g_pending);
 }
 
-Expected<bool> write_file_atomically(const std::filesystem::path& file_in,
+Expected<void> write_file_atomically(const std::filesystem::path& file_in,
                                      const std::function<bool(std::ostream&)>& write) {
   namespace fs = std::filesystem;
   std::error_code ec;
@@ -130,7 +130,7 @@ Expected<bool> write_file_atomically(const std::filesystem::path& file_in,
     fs::remove(tmp, ec);
     return Error{Status::io_error, file_in.string() + ": cannot rename temporary file: " + why};
   }
-  return true;
+  return {};
 }
 
 }  // namespace nonplanar

@@ -13,7 +13,7 @@ namespace nonplanar {
 /// Calls write(stream) on a temporary file in the target's folder, flushes it, and renames
 /// it to `file`. On any failure (write returns false, I/O error) the temporary is removed
 /// and an io_error "FILE: reason" is returned.
-Expected<bool> write_file_atomically(const std::filesystem::path& file,
+Expected<void> write_file_atomically(const std::filesystem::path& file,
                                      const std::function<bool(std::ostream&)>& write);
 
 /// Removes the temporary file a write_file_atomically call in progress is writing, if any.

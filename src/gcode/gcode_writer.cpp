@@ -348,7 +348,7 @@ Expected<std::string> make_gcode(const std::vector<LayerToolpaths>& layers, cons
   return std::move(em.out());
 }
 
-Expected<bool> check_custom_gcode(const PrintConfig& c) {
+Expected<void> check_custom_gcode(const PrintConfig& c) {
   const std::string start = expand(c.gcode.start_gcode, c), end = expand(c.gcode.end_gcode, c);
   for (const auto& [key, block] : {std::pair{"start_gcode", &start}, {"end_gcode", &end}}) {
     if (const std::string bad = unprintable_line(*block); !bad.empty())
@@ -365,10 +365,10 @@ Expected<bool> check_custom_gcode(const PrintConfig& c) {
   char at[80];  // the end block starts over the print, somewhere on the bed
   std::snprintf(at, sizeof at, "G92 X%g Y%g Z10\n", c.bed_center().x(), c.bed_center().y());
   if (auto e = check_block_on_bed("end_gcode", end, at, c)) return *e;
-  return true;
+  return {};
 }
 
-Expected<bool> write_gcode_file(const std::filesystem::path& file,
+Expected<void> write_gcode_file(const std::filesystem::path& file,
                                 const std::vector<LayerToolpaths>& layers, const PrintConfig& c,
                                 const std::vector<std::string>& header, const Context& ctx) {
   auto text = make_gcode(layers, c, header, ctx);
@@ -376,7 +376,7 @@ Expected<bool> write_gcode_file(const std::filesystem::path& file,
   return write_gcode_text(file, *text, ctx);
 }
 
-Expected<bool> write_gcode_text(const std::filesystem::path& file, const std::string& gcode,
+Expected<void> write_gcode_text(const std::filesystem::path& file, const std::string& gcode,
                                 const Context& ctx) {
   const std::string* text = &gcode;
   // Cancelled while writing: the writer removes its temporary, and no file appears.

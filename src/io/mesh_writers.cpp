@@ -7,7 +7,7 @@
 
 namespace nonplanar {
 
-Expected<bool> write_stl(const std::filesystem::path& file, const TriangleMesh& mesh) {
+Expected<void> write_stl(const std::filesystem::path& file, const TriangleMesh& mesh) {
   return write_file_atomically(file, [&](std::ostream& out) {
     char header[80] = "binary STL written by nonplanar";
     out.write(header, 80);
@@ -33,7 +33,7 @@ Expected<bool> write_stl(const std::filesystem::path& file, const TriangleMesh& 
   });
 }
 
-Expected<bool> write_ply_face_colors(const std::filesystem::path& file, const TriangleMesh& mesh,
+Expected<void> write_ply_face_colors(const std::filesystem::path& file, const TriangleMesh& mesh,
                                      const std::vector<unsigned>& face_colors) {
   if (face_colors.size() != mesh.faces.size())
     return Error{Status::invalid_argument, "face_colors: one colour per face expected"};

@@ -243,7 +243,7 @@ Expected<TriangleMesh> parse_3mf(std::string_view data, std::size_t max_triangle
 
 namespace nonplanar {
 
-Expected<bool> write_3mf(const std::filesystem::path& file, const TriangleMesh& mesh,
+Expected<void> write_3mf(const std::filesystem::path& file, const TriangleMesh& mesh,
                          const std::vector<PackageFile>& extra) {
   using io::Handle;
   Handle model, obj, item, writer;

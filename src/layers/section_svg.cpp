@@ -27,7 +27,7 @@ double nice_step(double range) {
 
 }  // namespace
 
-Expected<bool> write_section_svg(const std::filesystem::path& file, const TriangleMesh& mesh,
+Expected<void> write_section_svg(const std::filesystem::path& file, const TriangleMesh& mesh,
                                  const LayerPlan& plan, char axis, double value) {
   if (axis != 'x' && axis != 'y')
     return Error{Status::invalid_argument, "section axis: must be x or y"};

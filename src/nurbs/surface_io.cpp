@@ -84,7 +84,7 @@ SurfaceRecord from_json(const nlohmann::json& j) {
 
 }  // namespace
 
-Expected<bool> write_surfaces_json(const std::filesystem::path& file,
+Expected<void> write_surfaces_json(const std::filesystem::path& file,
                                    const std::vector<SurfaceRecord>& surfaces) {
   ordered_json doc = {{"format", "nonplanar-surfaces"}, {"version", 1}, {"units", "mm"}};
   ordered_json arr = ordered_json::array();
@@ -134,7 +134,7 @@ Expected<std::vector<SurfaceRecord>> read_surfaces_json(const std::filesystem::p
   return r;
 }
 
-Expected<bool> write_surfaces_obj(const std::filesystem::path& file,
+Expected<void> write_surfaces_obj(const std::filesystem::path& file,
                                   const std::vector<SurfaceRecord>& surfaces, int resolution) {
   resolution = std::max(resolution, 1);
   return write_file_atomically(file, [&](std::ostream& out) {

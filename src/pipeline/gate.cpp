@@ -29,14 +29,14 @@ std::optional<Error> nothing_to_print(const SliceResult& r, const TriangleMesh& 
   return Error{Status::invalid_mesh, buf};
 }
 
-Expected<bool> write_program(SliceResult& r, const SliceJob& job, const Context& ctx) {
-  if (!r.gcode.empty()) return true;
+Expected<void> write_program(SliceResult& r, const SliceJob& job, const Context& ctx) {
+  if (!r.gcode.empty()) return {};
   std::vector<std::string> header = r.header;
   header.insert(header.end(), job.header.begin(), job.header.end());
   auto text = make_gcode(r.layers, job.print, header, ctx);
   if (!text) return text.error();
   r.gcode = std::move(*text);
-  return true;
+  return {};
 }
 
 namespace {

@@ -26,7 +26,7 @@ Expected<bool> gate(SliceResult& r, const SliceJob& job, const layers::BandedFie
 /// r.gcode, the whole program, made by the built-in writer from r.layers when no engine wrote
 /// it (its header: r.header, then job.header). Errors: what make_gcode refuses (a move off the
 /// bed, custom G-code it cannot fill in), cancelled.
-Expected<bool> write_program(SliceResult& r, const SliceJob& job, const Context& ctx);
+Expected<void> write_program(SliceResult& r, const SliceJob& job, const Context& ctx);
 
 /// A part thinner than one extrusion, or an open sheet, slices to nothing: the error that
 /// says so (invalid_mesh, with the part's size), or nothing when r prints something.
