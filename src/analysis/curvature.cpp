@@ -1,6 +1,5 @@
 #include "analysis/curvature.hpp"
-
-#include <tbb/parallel_for.h>
+#include "core/parallel.hpp"
 
 #include <cmath>
 
@@ -33,9 +32,10 @@ VertexCurvature angle_deficit(const TriangleMesh& mesh, const MeshTopology& topo
   c.boundary.assign(nv, 0);
   auto in = [&](int f) { return f >= 0 && (!mask || (*mask)[f]); };
   // Gather per vertex over its faces: no two threads write the same vertex.
-  tbb::parallel_for(
-      tbb::blocked_range<std::size_t>(0, nv, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
-        for (std::size_t v = r.begin(); v != r.end(); ++v) {
+  core::parallel_blocks(
+      std::size_t{0}, std::size_t(nv), std::size_t{4096},
+      [&](std::size_t r_begin, std::size_t r_end) {
+        for (std::size_t v = r_begin; v != r_end; ++v) {
           double theta = 0.0, area = 0.0;
           bool touched = false, boundary = false;
           for (int i = topo.vertex_face_offsets[v]; i < topo.vertex_face_offsets[v + 1]; ++i) {

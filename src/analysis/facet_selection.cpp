@@ -1,6 +1,5 @@
 #include "analysis/facet_selection.hpp"
-
-#include <tbb/parallel_for.h>
+#include "core/parallel.hpp"
 
 #include <cmath>
 
@@ -16,18 +15,18 @@ FaceGeometry face_geometry(const TriangleMesh& mesh) {
   assign_huge(g.degenerate, nf, char{0});
   const double diag = bounding_box(mesh).size().norm();
   const double min_area = (1e-9 * diag) * (1e-9 * diag);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nf, 8192),
-                    [&](const tbb::blocked_range<std::size_t>& r) {
-                      for (std::size_t i = r.begin(); i != r.end(); ++i) {
-                        const auto& f = mesh.faces[i];
-                        const Vec3& a = mesh.vertices[f[0]];
-                        const Vec3 c = (mesh.vertices[f[1]] - a).cross(mesh.vertices[f[2]] - a);
-                        const double n = c.norm();
-                        g.areas[i] = 0.5 * n;
-                        g.degenerate[i] = g.areas[i] <= min_area;
-                        g.normals[i] = g.degenerate[i] ? Vec3::Zero() : Vec3(c / n);
-                      }
-                    });
+  core::parallel_blocks(std::size_t{0}, std::size_t(nf), std::size_t{8192},
+                        [&](std::size_t r_begin, std::size_t r_end) {
+                          for (std::size_t i = r_begin; i != r_end; ++i) {
+                            const auto& f = mesh.faces[i];
+                            const Vec3& a = mesh.vertices[f[0]];
+                            const Vec3 c = (mesh.vertices[f[1]] - a).cross(mesh.vertices[f[2]] - a);
+                            const double n = c.norm();
+                            g.areas[i] = 0.5 * n;
+                            g.degenerate[i] = g.areas[i] <= min_area;
+                            g.normals[i] = g.degenerate[i] ? Vec3::Zero() : Vec3(c / n);
+                          }
+                        });
   return g;
 }
 

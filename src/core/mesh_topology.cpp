@@ -1,8 +1,7 @@
 #include "core/mesh_topology.hpp"
+#include "core/parallel.hpp"
 
 #include "core/huge_pages.hpp"
-
-#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <atomic>
@@ -50,10 +49,10 @@ MeshTopology build_topology(const TriangleMesh& mesh) {
   assign_huge(t.across, 3 * static_cast<std::size_t>(nf), MeshTopology::kOpen);
   assign_huge(t.same_direction, 3 * static_cast<std::size_t>(nf), char{0});
   std::atomic<std::size_t> open{0}, nonman{0}, incons{0};
-  tbb::parallel_for(tbb::blocked_range<int>(0, nv, 1024), [&](const tbb::blocked_range<int>& r) {
+  core::parallel_blocks(int{0}, int(nv), int{1024}, [&](int r_begin, int r_end) {
     std::size_t l_open = 0, l_nonman = 0, l_incons = 0;
     std::vector<std::pair<int, int>> half;  // (higher end, corner 3·face + k)
-    for (int a = r.begin(); a != r.end(); ++a) {
+    for (int a = r_begin; a != r_end; ++a) {
       half.clear();
       for (int i = t.vertex_face_offsets[a]; i < t.vertex_face_offsets[a + 1]; ++i) {
         const int g = t.vertex_faces[i];

@@ -1,11 +1,10 @@
 // Inverse of the normalisation for toolpaths (DESIGN.md §2 step 6); notation in
 // map_segment.hpp.
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
 #include <atomic>
 #include <cmath>
 
+#include "core/parallel.hpp"
 #include "deform/map_segment.hpp"
 #include "nonplanar/deform.hpp"
 #include "program/layer_passes.hpp"
@@ -88,7 +87,7 @@ Expected<std::vector<LayerToolpaths>> map_toolpaths_back(const std::vector<Layer
   if (!(params.tolerance > 0)) return Error{Status::invalid_argument, "map tolerance: must be > 0"};
   std::vector<LayerToolpaths> out(planar.size());
   std::atomic<bool> stop{false};
-  tbb::parallel_for(std::size_t{0}, planar.size(), [&](std::size_t li) {
+  core::parallel_for(std::size_t{0}, planar.size(), [&](std::size_t li) {
     if (stop || ctx.cancelled()) return stop = true, void();
     const LayerToolpaths& L = planar[li];
     LayerToolpaths& M = out[li];

@@ -1,11 +1,10 @@
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <unordered_map>
 #include <unordered_set>
 
+#include "core/parallel.hpp"
 #include "nonplanar/deform.hpp"
 
 namespace nonplanar {
@@ -31,8 +30,8 @@ Expected<NormalizedMesh> normalize_mesh(const TriangleMesh& mesh, const LayerFie
   std::vector<Vec3> image(m.vertices.size());
   // Field evaluations are the cost (a root-find in blend zones): in parallel, then the
   // bookkeeping in order, so the result does not depend on the thread count.
-  tbb::parallel_for(std::size_t{0}, m.vertices.size(),
-                    [&](std::size_t v) { image[v] = mapped(field, m.vertices[v]); });
+  core::parallel_for(std::size_t{0}, m.vertices.size(),
+                     [&](std::size_t v) { image[v] = mapped(field, m.vertices[v]); });
 
   // Edges already tested and kept whole keep their ends (vertices are only appended), so
   // the same test would keep them whole again: only edges made by a split are tested, and a
@@ -55,7 +54,7 @@ Expected<NormalizedMesh> normalize_mesh(const TriangleMesh& mesh, const LayerFie
     }
     std::vector<Vec3> im(edges.size());
     std::vector<char> split_it(edges.size());
-    tbb::parallel_for(std::size_t{0}, edges.size(), [&](std::size_t e) {
+    core::parallel_for(std::size_t{0}, edges.size(), [&](std::size_t e) {
       const auto [a, b] = edges[e];
       const Vec3 pm = 0.5 * (m.vertices[a] + m.vertices[b]);
       im[e] = mapped(field, pm);

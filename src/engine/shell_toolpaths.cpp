@@ -1,6 +1,5 @@
 #include "engine/shell_toolpaths.hpp"
-
-#include <tbb/parallel_for.h>
+#include "core/parallel.hpp"
 
 #include <algorithm>
 
@@ -28,7 +27,7 @@ Expected<std::vector<LayerToolpaths>> shell_toolpaths(const TriangleMesh& mesh,
   const auto [lo_it, hi_it] = std::minmax_element(plan.top.h.begin(), plan.top.h.end());
   const double h_lo = *lo_it, h_hi = *hi_it;
   const layers::ContourIndex index(plan.top);
-  tbb::parallel_for(std::size_t{0}, core->size(), [&](std::size_t k) {
+  core::parallel_for(std::size_t{0}, core->size(), [&](std::size_t k) {
     SlicedLayer& L = (*core)[k];
     const double level = plan.core_level(L.z_top);
     if (level <= h_lo || L.islands.empty()) return;

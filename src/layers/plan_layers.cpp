@@ -1,7 +1,5 @@
 // plan_layers: stacks per patch, then the field, then a check of the blend zones inside the
 // material; a patch whose blend breaks a limit is dropped to planar and the field rebuilt.
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -9,6 +7,7 @@
 #include <optional>
 
 #include "core/column_caster.hpp"
+#include "core/parallel.hpp"
 #include "layers/banded_field.hpp"
 #include "layers/stack_builder.hpp"
 
@@ -77,7 +76,7 @@ std::string check_blend(const BandedField& field, const Band& b, const ColumnCas
   // verdicts below walk the columns in order, so the reported place does not depend on it.
   std::vector<std::vector<double>> zc(cols.size());
   std::vector<std::vector<std::pair<double, double>>> ivc(cols.size());
-  tbb::parallel_for(std::size_t{0}, cols.size(), [&](std::size_t c) {
+  core::parallel_for(std::size_t{0}, cols.size(), [&](std::size_t c) {
     const double x = b.blend_origin.x() + cols[c].first * b.blend_cell,
                  y = b.blend_origin.y() + cols[c].second * b.blend_cell;
     ivc[c] = columns.intervals(x, y);

@@ -1,6 +1,5 @@
 #include "layers/printability_cost.hpp"
-
-#include <tbb/parallel_for.h>
+#include "core/parallel.hpp"
 
 #include <algorithm>
 #include <array>
@@ -98,7 +97,7 @@ double printability_cost(const StackGrid& g, const Eigen::MatrixXd& Z, const Cos
   constexpr int kChunks = 16;
   std::array<double, kChunks> part{};
   std::array<Eigen::MatrixXd, kChunks> part_grad;
-  tbb::parallel_for(0, kChunks, [&](int ch) {
+  core::parallel_for(0, kChunks, [&](int ch) {
     double cost = 0;
     Eigen::MatrixXd* gr = nullptr;
     if (grad) part_grad[ch].setZero(grad->rows(), grad->cols()), gr = &part_grad[ch];

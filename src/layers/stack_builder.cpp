@@ -1,9 +1,8 @@
 #include "layers/stack_builder.hpp"
+#include "core/parallel.hpp"
 
 #include <ceres/gradient_problem.h>
 #include <ceres/gradient_problem_solver.h>
-
-#include <tbb/task_group.h>
 
 #include <algorithm>
 #include <cmath>
@@ -23,20 +22,7 @@ std::string fmt2(const char* f, double a, double b) {
   return buf;
 }
 
-// A task run beside the caller, waited for on every way out (tbb::task_group must be waited
-// for before it is destroyed).
-class Background {
- public:
-  ~Background() { group_.wait(); }
-  template <class F>
-  void run(F&& f) {
-    group_.run(std::forward<F>(f));
-  }
-  void wait() { group_.wait(); }
-
- private:
-  tbb::task_group group_;
-};
+using core::Background;  // a task run beside the caller, waited for on every way out
 
 class StackObjective final : public ceres::FirstOrderFunction {
  public:

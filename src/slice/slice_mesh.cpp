@@ -1,12 +1,11 @@
 // Planar slicing: triangle–plane segments chained through the mesh's edges into loops.
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <unordered_map>
 
+#include "core/parallel.hpp"
 #include "core/polygon_ops.hpp"
 #include "nonplanar/slice.hpp"
 
@@ -120,7 +119,6 @@ std::vector<Polygon> layer_loops(const TriangleMesh& m, const std::vector<int>& 
 
 }  // namespace
 
-
 Expected<std::vector<SlicedLayer>> slice_mesh(const TriangleMesh& mesh, const SliceParams& p,
                                               const Context& ctx) {
   if (!(p.layer_height > 0) || !(p.first_layer_height > 0) || !std::isfinite(p.layer_height) ||
@@ -163,7 +161,7 @@ Expected<std::vector<SlicedLayer>> slice_mesh_at(const TriangleMesh& mesh,
   for (std::size_t i = 0; i < nf; ++i) sorted_lo[i] = lo[order[i]];
   std::atomic<bool> stop{false};
   std::atomic<std::size_t> done{0};
-  tbb::parallel_for(std::size_t{0}, layers.size(), [&](std::size_t i) {
+  core::parallel_for(std::size_t{0}, layers.size(), [&](std::size_t i) {
     if (stop || ctx.cancelled()) return stop = true, void();
     const double h = layers[i].z_slice;
     std::vector<int> cand;

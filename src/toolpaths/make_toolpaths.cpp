@@ -1,9 +1,8 @@
 // make_toolpaths: perimeters, skins, infill and skirt per layer (DESIGN.md §2 step 6).
-#include <tbb/parallel_for.h>
-
 #include <atomic>
 #include <cmath>
 
+#include "core/parallel.hpp"
 #include "toolpaths/toolpath_parts.hpp"
 
 namespace nonplanar {
@@ -74,7 +73,7 @@ Expected<std::vector<LayerToolpaths>> make_toolpaths(const std::vector<SlicedLay
   std::vector<LayerRegions> reg(n);
   std::atomic<bool> stop{false};
   // Pass 1: perimeters and the infill area of every island.
-  tbb::parallel_for(std::size_t{0}, n, [&](std::size_t i) {
+  core::parallel_for(std::size_t{0}, n, [&](std::size_t i) {
     if (stop || ctx.cancelled()) return stop = true, void();
     const double h = layers[i].z_top - layers[i].z_bottom;
     const double wp = i == 0 ? P.first_layer_width : P.perimeter_width;
@@ -93,7 +92,7 @@ Expected<std::vector<LayerToolpaths>> make_toolpaths(const std::vector<SlicedLay
     return layers[k].covers.empty() ? layers[k].islands : layers[k].covers;
   };
   std::vector<LayerToolpaths> out(n);
-  tbb::parallel_for(std::size_t{0}, n, [&](std::size_t i) {
+  core::parallel_for(std::size_t{0}, n, [&](std::size_t i) {
     if (stop || ctx.cancelled()) return stop = true, void();
     const SlicedLayer& L = layers[i];
     const double h = L.z_top - L.z_bottom, z = L.z_top;
