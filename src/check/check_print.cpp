@@ -1,6 +1,6 @@
 // The quality figures of DESIGN.md §4, from moves alone.
 //
-// Notation: an extrusion point is a sample along an extruding move (every ≤ 0.3 mm) with its
+// Notation: an extrusion point is a sample along an extruding move (every ≤ 0.2 mm) with its
 // layer; E_L(x, y) is layer L's extrusion height near (x, y), the least-squares plane
 // through its points within 0.6 mm. Collision model (§3): nozzle tip radius r, wall angle α,
 // block radius R and clearance H; earlier layers' material at q penetrates the nozzle at p by
