@@ -78,13 +78,7 @@ std::optional<Error> map_layer(LayerWork& work, const LayerField& field, double 
     if (points > 50'000'000)
       return Error{Status::invalid_argument,
                    "line " + std::to_string(m.line) + ": more than 50 million mapped points"};
-    for (std::size_t q = 0; q < p.points.size(); ++q) {
-      L.max_z = std::max(L.max_z, p.points[q].z());
-      if (q == 0) continue;
-      const double dxy = (p.points[q] - p.points[q - 1]).head<2>().norm();
-      if (dxy > 1e-3)
-        L.max_slope = std::max(L.max_slope, std::abs(p.points[q].z() - p.points[q - 1].z()) / dxy);
-    }
+    add_to_reach(p, L);
   }
   if (L.max_z < -1e299) L.max_z = 0;
   return std::nullopt;

@@ -25,4 +25,9 @@ Mapped map_point(const LayerField& f, const Vec3& q, double h_planar);
 void map_segment(const LayerField& f, const Vec3& a, const Mapped& ma, const Vec3& b,
                  const Mapped& mb, double h, double tol, int depth, ExtrusionPath& out);
 
+/// Widens L's highest point (max_z) and steepest slope (max_slope, |dz| / dxy over pieces
+/// longer than 1 µm in XY) by the mapped path p, which set how travels clear the layer;
+/// *min_z, when given, gets its lowest point.
+void add_to_reach(const ExtrusionPath& p, LayerToolpaths& L, double* min_z = nullptr);
+
 }  // namespace nonplanar

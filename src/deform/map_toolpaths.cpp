@@ -41,6 +41,18 @@ void map_segment(const LayerField& f, const Vec3& a, const Mapped& ma, const Vec
   out.height.push_back(mb.height);
 }
 
+void add_to_reach(const ExtrusionPath& p, LayerToolpaths& L, double* min_z) {
+  for (std::size_t k = 0; k < p.points.size(); ++k) {
+    const Vec3& v = p.points[k];
+    L.max_z = std::max(L.max_z, v.z());
+    if (min_z) *min_z = std::min(*min_z, v.z());
+    if (k == 0) continue;
+    const double dxy = (v - p.points[k - 1]).head<2>().norm();
+    if (dxy > 1e-3)
+      L.max_slope = std::max(L.max_slope, std::abs(v.z() - p.points[k - 1].z()) / dxy);
+  }
+}
+
 namespace {
 
 bool is_top(const ExtrusionPath& p) {
@@ -108,14 +120,7 @@ Expected<std::vector<LayerToolpaths>> map_toolpaths_back(const std::vector<Layer
                     0, q);
         prev = cur;
       }
-      for (std::size_t k = 0; k < q.points.size(); ++k) {
-        const Vec3& v = q.points[k];
-        M.max_z = std::max(M.max_z, v.z()), min_z = std::min(min_z, v.z());
-        if (k == 0) continue;
-        const double dxy = (v - q.points[k - 1]).head<2>().norm();
-        if (dxy > 1e-3)
-          M.max_slope = std::max(M.max_slope, std::abs(v.z() - q.points[k - 1].z()) / dxy);
-      }
+      add_to_reach(q, M, &min_z);
       M.paths.push_back(std::move(q));
     }
     M.nonplanar = M.max_z - min_z > 1e-6;
