@@ -2,7 +2,9 @@
 # The test suite under ThreadSanitizer, built with clang-14 into build-tsan/: the pipeline's
 # stages run tbb::parallel_for (layers, slicing, toolpaths, deform, analysis), and a data race
 # there would print differently from run to run. Any report fails the test that triggered it.
-# TBB itself is Debian's uninstrumented build; scripts/tsan.supp lists what is suppressed there.
+# TBB is Debian's uninstrumented build, so under TSan the loops run on plain std::threads
+# (src/core/parallel.hpp) and TSan sees every synchronisation; scripts/tsan.supp holds what is
+# suppressed in libraries we do not build (nothing, so far).
 # Usage: scripts/tsan.sh [CTEST_REGEX]   (default: every test)
 # Environment: BUILD_DIR (default build-tsan); CI=true turns warnings into errors.
 set -euo pipefail
@@ -16,6 +18,14 @@ command -v ninja >/dev/null && [[ ! -f "$build_dir/CMakeCache.txt" ]] && generat
 CXX=clang++-14 cmake -S . -B "$build_dir" "${generator[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DNONPLANAR_TSAN=ON -DNONPLANAR_BUILD_BENCH=OFF -DNONPLANAR_WERROR="$werror" >/dev/null
 cmake --build "$build_dir" -j"$(nproc)"
+# Ceres' sparse solves reach CHOLMOD and OpenBLAS, which run OpenMP threads whose runtime is
+# not instrumented either: as few of them as can be (one), and what libgomp still does is
+# suppressed (scripts/tsan.supp), so every report is about our own threads.
+export OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1
 export TSAN_OPTIONS=${TSAN_OPTIONS:-halt_on_error=1:second_deadlock_stack=1:suppressions=$PWD/scripts/tsan.supp}
 cd "$build_dir"
-ctest --output-on-failure -j"$(nproc)" --timeout 1800 ${1:+-R "$1"}
+# StopsWhileALibraryCannotBeCancelled times a signal against lib3mf's reading, which runs
+# several times slower under TSan than the test's clock allows; it is about cancellation, not
+# threads, and runs in the other builds.
+ctest --output-on-failure -j"$(nproc)" --timeout 1800 -E 'StopsWhileALibraryCannotBeCancelled' \
+  ${1:+-R "$1"}

@@ -85,8 +85,8 @@ void add_limit_options(CLI::App& app, Limits& l) {
 bool install_limits(const Limits& l) {
   g_max_memory = l.max_memory_mb, g_max_time = l.max_time_s;
   if (l.max_memory_mb > 0) {
-#if defined(NONPLANAR_ASAN)
-    std::fprintf(stderr, "warning: --max-memory is not enforced in an AddressSanitizer build\n");
+#if defined(NONPLANAR_SHADOW_MEMORY)
+    std::fprintf(stderr, "warning: --max-memory is not enforced in a sanitizer build\n");
 #else
     const auto bytes = static_cast<rlim_t>(l.max_memory_mb * 1048576.0);
     const struct rlimit r { bytes, bytes };
