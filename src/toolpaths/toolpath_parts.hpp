@@ -7,9 +7,9 @@
 
 #include <vector>
 
-#include "nonplanar/toolpaths.hpp"
 #include "core/polygon_ops.hpp"
 #include "nonplanar/slice.hpp"
+#include "nonplanar/toolpaths.hpp"
 
 namespace nonplanar::paths {
 

@@ -5,8 +5,8 @@
 
 #include "nonplanar/check.hpp"
 #include "nonplanar/deform.hpp"
-#include "nonplanar/patch_fit.hpp"
 #include "nonplanar/gcode.hpp"
+#include "nonplanar/patch_fit.hpp"
 #include "nonplanar/pipeline.hpp"
 #include "support/solids.hpp"
 
