@@ -30,14 +30,6 @@ void GateZones::find_last_layers(const std::vector<LayerToolpaths>& layers) {
     }
 }
 
-bool GateZones::may_matter(const ExtrusionPath& p, int layer) const {
-  const BoundingBox pb = box_of(p);
-  for (std::size_t b = 0; b < material.size(); ++b)
-    if ((b >= last_layer.size() || layer <= last_layer[b]) && pb.intersects(material[b]))
-      return true;
-  return false;
-}
-
 bool GateZones::may_matter(const GcodeMove& m, int layer) const {
   const BoundingBox mb{m.from.cwiseMin(m.to), m.from.cwiseMax(m.to)};
   for (std::size_t b = 0; b < material.size(); ++b)

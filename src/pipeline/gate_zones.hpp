@@ -26,10 +26,8 @@ struct GateZones {
   std::vector<int> last_layer;  ///< per band: the last layer with a point in its query box
   /// Sets last_layer from the paths (layers[i] is layer i).
   void find_last_layers(const std::vector<LayerToolpaths>& layers);
-  /// Can this path of layer `layer` matter to the gate (meet a material box, no later than
-  /// its last layer)?
-  bool may_matter(const ExtrusionPath& p, int layer) const;
-  /// The same for one move of the program (its segment's box).
+  /// Can this move of layer `layer` matter to the gate (its segment's box meets a material
+  /// box, no later than that box's last layer)?
   bool may_matter(const GcodeMove& m, int layer) const;
 };
 
