@@ -127,8 +127,39 @@ void MeshOptions::add_to(CLI::App& cmd) {
   cmd.add_flag("-q,--quiet", quiet, "No progress or warnings on stderr");
 }
 
+void PresetOptions::add_to(CLI::App& cmd) {
+  cmd.add_option("--printer-profile", printer,
+                 "A printer preset by name from a vendor bundle (e.g. \"Original Prusa i3 MK3S &\n"
+                 "MK3S+\"), its inherits chain resolved");
+  cmd.add_option("--print-profile", print, "A print preset by name (e.g. \"0.20mm QUALITY @MK3\")");
+  cmd.add_option("--material-profile", material,
+                 "A filament preset by name (e.g. \"Prusament PLA\")");
+  cmd.add_option("--profiles-dir", dir,
+                 "Vendor bundles to find presets in: a folder of .ini or one .ini")
+      ->capture_default_str();
+}
+
+Expected<void> PresetOptions::apply(PrintConfig& c,
+                                    std::vector<std::pair<std::string, std::string>>* keys) const {
+  for (const auto& [type, name] :
+       {std::pair{"printer", &printer}, {"print", &print}, {"filament", &material}}) {
+    if (name->empty()) continue;
+    auto found = find_preset(dir, type, *name);
+    if (!found) return found.error();
+    for (const auto& [k, v] : *found) {
+      auto r = set_config_value(c, k, v);
+      if (!r)
+        return Error{r.error().status,
+                     std::string(type) + " preset '" + *name + "': " + r.error().message};
+      if (keys) keys->emplace_back(k, v);
+    }
+  }
+  return {};
+}
+
 void ProfileOptions::add_to(CLI::App& cmd, const std::string& what) {
-  cmd.add_option("--config", config,
+  presets.add_to(cmd);
+  cmd.add_option("--load,--config", config,
                  "Profile: .json or PrusaSlicer .ini (" + what +
                      "); repeat it for a printer, a print and a filament file, each over the "
                      "ones before");
@@ -158,6 +189,7 @@ void ProfileOptions::add_keyed(CLI::App& cmd, const std::string& name, const std
 
 Expected<PrintConfig> ProfileOptions::load() const {
   PrintConfig cfg;
+  if (auto p = presets.apply(cfg); !p) return p.error();
   for (const std::string& file : config) {
     auto c = load_config(file, std::move(cfg));
     if (!c) return c.error();

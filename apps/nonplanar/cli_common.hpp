@@ -12,6 +12,7 @@
 #include "nonplanar/config.hpp"
 #include "nonplanar/context.hpp"
 #include "nonplanar/io.hpp"
+#include "nonplanar/presets.hpp"
 #include "nonplanar/status.hpp"
 
 namespace nonplanar::cli {
@@ -46,9 +47,21 @@ struct MeshOptions {
   void add_to(CLI::App& cmd);
 };
 
+/// Presets by name from a vendor bundle (--printer-profile, --print-profile,
+/// --material-profile, --profiles-dir), applied before any --load file, as PrusaSlicer does.
+struct PresetOptions {
+  std::string printer, print, material, dir = kDefaultProfilesDir;
+  void add_to(CLI::App& cmd);
+  /// Applies the named presets over `c` in PrusaSlicer's order (printer, print, filament);
+  /// `keys` (if given) receives every key = value they set, for another slicer.
+  Expected<void> apply(PrintConfig& c,
+                       std::vector<std::pair<std::string, std::string>>* keys = nullptr) const;
+};
+
 /// The print profile a subcommand reads: --config FILE, then --set KEY=VALUE in order (any
 /// PrusaSlicer key we read, and ours: the toolhead's keys, docs/toolhead.md).
 struct ProfileOptions {
+  PresetOptions presets;
   std::vector<std::string> config;  ///< profiles, each over the ones before it
   std::vector<std::string> sets;
   /// A subcommand's own options that are profile keys (--block-radius is

@@ -13,6 +13,7 @@ namespace {
 
 struct SliceOptions {
   MeshOptions mesh;
+  PresetOptions presets;
   std::string output;
   std::vector<std::string> config;  ///< profiles, each over the ones before
   std::string engine = "builtin", engine_path, engine_config, engine_filaments;
@@ -41,6 +42,11 @@ int run(const SliceOptions& o) {
   engine.filaments = o.engine_filaments;
   // PrusaSlicer's profile is ours too (layer heights, bed, filament), unless --config names
   // one. Several --config files load in order, each over the ones before.
+  std::vector<std::pair<std::string, std::string>> preset_keys;
+  if (auto p = o.presets.apply(cfg, &preset_keys); !p) return report_error(p.error());
+  // The engine gets the presets as keys, before the user's own overrides.
+  for (auto& [k, v] : preset_keys)
+    if (!is_nonplanar_key(k)) engine.overrides.emplace_back(std::move(k), std::move(v));
   std::vector<std::string> profiles = o.config;
   if (profiles.empty() && engine.engine == Engine::prusaslicer && !o.engine_config.empty())
     profiles.push_back(o.engine_config);
@@ -131,7 +137,8 @@ void register_slice(CLI::App& app, std::function<int()>* run_fn) {
       "the options below (or --set KEY=VALUE with any PrusaSlicer key) override it.");
   o->mesh.add_to(*cmd);
   cmd->add_option("-o,--output", o->output, "G-code file to write (atomically)")->required();
-  cmd->add_option("--config", o->config,
+  o->presets.add_to(*cmd);
+  cmd->add_option("--load,--config", o->config,
                   "Profile: .json or PrusaSlicer .ini; repeat it for a printer, a print and a\n"
                   "filament file (PrusaSlicer exports them one by one), each over the ones before");
   cmd->add_flag("--planar", o->planar, "Planar layers only (the ordinary slicing engine)");

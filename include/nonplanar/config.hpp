@@ -4,6 +4,7 @@
 #pragma once
 
 #include <filesystem>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -62,6 +63,10 @@ struct GcodeParams {
       "G1 X2 Y20 Z0.3 F6000\nG1 Y200 E15 F1200 ; purge line\nG92 E0\n";
   std::string end_gcode =
       "M104 S0 ; heater off\nM140 S0 ; bed off\nM107\nG91\nG1 Z10 F600\nG90\nM84\n";
+  /// At each layer change, before and after the move to the new layer (PrusaSlicer's
+  /// before_layer_gcode and layer_gcode), and around the print for the first extruder's
+  /// filament. Every block is a template of PrusaSlicer's macro language (macros.hpp).
+  std::string before_layer_gcode, layer_gcode, start_filament_gcode, end_filament_gcode;
 };
 
 /// Settings PrusaSlicer states relative to others, as written: "150%" (widths: of the layer
@@ -95,6 +100,9 @@ struct PrintConfig {
   Toolhead toolhead;          ///< nozzle cone, heater block, the rest of the head (toolhead.hpp)
   RelativeSettings relative;  ///< what the relative fields above were resolved from
   std::vector<std::string> notes;  ///< settings that were read but adapted (shown as warnings)
+  /// Every key set, as written (PrusaSlicer's text, escapes intact), known to us or not: what
+  /// the custom G-code's macros read, and what another engine is given.
+  std::map<std::string, std::string> profile;
   Vec2 bed_center() const { return 0.5 * (bed_min + bed_max); }
 };
 

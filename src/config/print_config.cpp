@@ -55,6 +55,18 @@ std::string unescape(const std::string& v) {
   return out;
 }
 
+// The first string of a per-extruder list as PrusaSlicer writes it ("\"a\";\"b\""), its escapes
+// undone; a value without quotes is one string.
+std::string first_string(const std::string& v) {
+  if (v.empty() || v.front() != '"') return unescape(v);
+  std::string item;
+  for (std::size_t p = 1; p < v.size() && v[p] != '"'; ++p) {
+    if (v[p] == '\\' && p + 1 < v.size()) item += v[p++];
+    item += v[p];
+  }
+  return unescape(item);
+}
+
 // PrusaSlicer's rules, checked against prusa-slicer 2.5's own G-code header: a width in % is
 // of the layer height (the first layer's, for first_layer_extrusion_width), not of the
 // nozzle; a role's width of 0 means extrusion_width, and extrusion_width 0 means
@@ -202,6 +214,11 @@ Expected<bool> set_value(PrintConfig& c, const std::string& key, const std::stri
     return g.start_gcode = unescape(value), true;
   }
   if (key == "end_gcode") return g.end_gcode = unescape(value), true;
+  if (key == "before_layer_gcode") return g.before_layer_gcode = unescape(value), true;
+  if (key == "layer_gcode") return g.layer_gcode = unescape(value), true;
+  // Per-extruder lists ("\"M900 K0\";\"…\""): the first extruder's.
+  if (key == "start_filament_gcode") return g.start_filament_gcode = first_string(value), true;
+  if (key == "end_filament_gcode") return g.end_filament_gcode = first_string(value), true;
   Toolhead& head = c.toolhead;
   if (key == "nozzle_tip_radius") return num(head.tip_radius);
   if (key == "nozzle_cone_angle") return num(head.cone_angle_deg);
@@ -247,6 +264,7 @@ Expected<bool> set_value(PrintConfig& c, const std::string& key, const std::stri
 Expected<bool> set_config_value(PrintConfig& c, const std::string& key, const std::string& value) {
   auto r = set_value(c, key, value);
   if (r && *r) resolve_relative(c);
+  if (r) c.profile[key] = value;
   return r;
 }
 
@@ -284,10 +302,6 @@ Expected<void> validate_config(const PrintConfig& c) {
     if (!std::isfinite(v) || v < 0) return bad(k, "must be a finite number >= 0 (0: automatic)");
   if (c.min_layer_height > 0 && c.max_layer_height > 0 && c.min_layer_height > c.max_layer_height)
     return bad("min_layer_height", "is above max_layer_height");
-  if (c.min_layer_height > c.slice.layer_height)
-    return bad("min_layer_height", "is above layer_height");
-  if (c.max_layer_height > 0 && c.max_layer_height < c.slice.layer_height)
-    return bad("max_layer_height", "is below layer_height");
   if (c.max_layer_height > d) return bad("max_layer_height", "is larger than the nozzle diameter");
   if (!pos(g.filament_diameter, 5)) return bad("filament_diameter", "must be in (0, 5] mm");
   if (!pos(g.extrusion_multiplier, 5)) return bad("extrusion_multiplier", "must be in (0, 5]");

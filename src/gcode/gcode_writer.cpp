@@ -12,6 +12,7 @@
 
 #include "core/atomic_file.hpp"
 #include "nonplanar/gcode.hpp"
+#include "nonplanar/macros.hpp"
 #include "program/gcode_text.hpp"
 
 namespace nonplanar {
@@ -35,33 +36,102 @@ const char* flavor_name(GcodeFlavor f) {
   return "marlin2";
 }
 
-// Replaces {key}, [key], {key[0]} and [key[0]] for the keys we know.
-std::string expand(std::string t, const PrintConfig& c) {
-  const GcodeParams& g = c.gcode;
-  const std::pair<const char*, double> vars[] = {
-      {"first_layer_bed_temperature", g.first_layer_bed_temperature},
-      {"first_layer_temperature", g.first_layer_temperature},
-      {"bed_temperature", g.bed_temperature},
-      {"temperature", g.temperature},
-      {"first_layer_height", c.slice.first_layer_height},
-      {"layer_height", c.slice.layer_height},
-      {"nozzle_diameter", c.paths.nozzle_diameter},
-      {"filament_diameter", g.filament_diameter}};
-  for (const auto& [name, v] : vars) {
-    char num[32];
-    std::snprintf(num, sizeof num, "%g", v);
-    for (const std::string& open : {std::string("{"), std::string("[")}) {
-      const std::string close = open == "{" ? "}" : "]";
-      for (const std::string& suffix :
-           {std::string(), std::string("[0]"), std::string("[initial_extruder]")}) {
-        const std::string key = open + name + suffix + close;
-        for (std::size_t p = t.find(key); p != std::string::npos; p = t.find(key, p))
-          t.replace(p, key.size(), num);
-      }
+// What PrusaSlicer knows of the print when it expands a block, from the layers written.
+struct PrintFacts {
+  Vec2 first_min{0, 0}, first_max{0, 0};  ///< footprint of the first layer's extrusions
+  double max_layer_z = 0;                 ///< the highest point printed
+  int layers = 0;
+};
+
+PrintFacts facts_of(const std::vector<LayerToolpaths>& layers, const PrintConfig& c) {
+  PrintFacts f;
+  f.first_min = f.first_max = c.bed_center();
+  f.layers = static_cast<int>(layers.size());
+  bool any = false;
+  for (const LayerToolpaths& L : layers) f.max_layer_z = std::max({f.max_layer_z, L.z, L.max_z});
+  if (layers.empty()) return f;
+  Vec2 lo(1e300, 1e300), hi(-1e300, -1e300);
+  for (const ExtrusionPath& p : layers.front().paths) {
+    if (p.role == ExtrusionRole::skirt) continue;
+    for (const Vec3& q : p.points) {  // the bead's outer edge, as PrusaSlicer's slice outline
+      lo = lo.cwiseMin(q.head<2>() - Vec2::Constant(0.5 * p.width));
+      hi = hi.cwiseMax(q.head<2>() + Vec2::Constant(0.5 * p.width));
+      any = true;
     }
   }
-  if (!t.empty() && t.back() != '\n') t += '\n';
-  return t;
+  if (any) f.first_min = lo, f.first_max = hi;
+  return f;
+}
+
+MacroValue number(double v) {
+  return v == std::floor(v) && std::abs(v) < 1e9 ? MacroValue::integer(static_cast<long long>(v))
+                                                 : MacroValue::real(v);
+}
+
+std::vector<MacroValue> pair(const Vec2& v) {
+  return {MacroValue::real(v.x()), MacroValue::real(v.y())};
+}
+
+// The variables every block sees: PrusaSlicer's defaults for keys a profile may leave out,
+// the profile's own keys, what we resolved from them, and the print's facts.
+MacroVariables block_variables(const PrintConfig& c, const PrintFacts& f) {
+  MacroVariables v;
+  for (const auto& [k, t] : {std::pair{"printer_model", ""},
+                             {"printer_notes", ""},
+                             {"print_settings_id", ""},
+                             {"printer_settings_id", ""},
+                             {"input_filename_base", "model"},
+                             {"gcode_flavor", "marlin2"}})
+    v.set(k, MacroValue::text(t));
+  v.set_vector("filament_settings_id", {MacroValue::text("")});
+  v.set_vector("filament_type", {MacroValue::text("PLA")});
+  v.set("z_offset", MacroValue::integer(0));
+  v.set("max_print_height", MacroValue::integer(200));
+  for (const auto& [k, raw] : c.profile) v.set_from_profile(k, raw);
+  const GcodeParams& g = c.gcode;
+  const ToolpathParams& t = c.paths;
+  for (const auto& [k, x] : {std::pair{"first_layer_temperature", g.first_layer_temperature},
+                             {"temperature", g.temperature},
+                             {"bed_temperature", g.bed_temperature},
+                             {"first_layer_bed_temperature", g.first_layer_bed_temperature},
+                             {"nozzle_diameter", t.nozzle_diameter},
+                             {"filament_diameter", g.filament_diameter},
+                             {"retract_length", g.retract_length},
+                             {"retract_speed", g.retract_speed},
+                             {"retract_lift", g.retract_lift}})
+    v.set_vector(k, {number(x)});
+  for (const auto& [k, x] : {std::pair{"layer_height", c.slice.layer_height},
+                             {"first_layer_height", c.slice.first_layer_height},
+                             {"extrusion_width", t.extrusion_width},
+                             {"travel_speed", t.travel_speed},
+                             {"perimeter_speed", t.perimeter_speed}})
+    v.set(k, number(x));
+  v.set("use_relative_e_distances", MacroValue::integer(g.relative_e));
+  for (const char* k : {"initial_extruder", "initial_tool", "current_extruder",
+                        "current_object_idx", "total_toolchanges", "layer_num"})
+    v.set(k, MacroValue::integer(0));
+  for (const char* k : {"has_wipe_tower", "has_single_extruder_multi_material_priming"})
+    v.set(k, MacroValue::boolean(false));
+  v.set_vector("is_extruder_used", {MacroValue::boolean(true)});
+  v.set("num_extruders", MacroValue::integer(1));
+  v.set_vector("first_layer_print_min", pair(f.first_min));
+  v.set_vector("first_layer_print_max", pair(f.first_max));
+  v.set_vector("first_layer_print_size", pair(f.first_max - f.first_min));
+  v.set_vector("print_bed_min", pair(c.bed_min));
+  v.set_vector("print_bed_max", pair(c.bed_max));
+  v.set_vector("print_bed_size", pair(c.bed_max - c.bed_min));
+  v.set("max_layer_z", MacroValue::real(f.max_layer_z));
+  v.set("layer_z", MacroValue::real(f.max_layer_z));
+  v.set("total_layer_count", MacroValue::integer(f.layers));
+  v.set("zhop", MacroValue::integer(0));
+  return v;
+}
+
+// One custom block, expanded and ending in a newline ("" stays "").
+Expected<std::string> expand(const std::string& t, const MacroVariables& v, const char* key) {
+  auto r = expand_macros(t, v, key);
+  if (r && !r->empty() && r->back() != '\n') *r += '\n';
+  return r;
 }
 
 // The command word of one line, upper-cased and without its comment: "M190", "G1", "".
@@ -129,8 +199,8 @@ std::string unprintable_line(std::string_view block) {
   return why;
 }
 
-bool on_bed(const Vec3& p, const PrintConfig& c) {
-  constexpr double eps = 1e-3;  // what %.3f may round
+bool on_bed(const Vec3& p, const PrintConfig& c, double margin = 0) {
+  const double eps = 1e-3 + margin;  // what %.3f may round
   return p.x() >= c.bed_min.x() - eps && p.x() <= c.bed_max.x() + eps &&
          p.y() >= c.bed_min.y() - eps && p.y() <= c.bed_max.y() + eps;
 }
@@ -151,7 +221,9 @@ std::optional<Error> check_block_on_bed(const std::string& key, const std::strin
   const int skip = static_cast<int>(std::count(prefix.begin(), prefix.end(), '\n'));
   for (const PrintMove& m : *moves) {
     const bool moved_xy = (m.to.head<2>() - m.from.head<2>()).norm() > 0;
-    if (!moved_xy || on_bed(m.to, c)) continue;
+    // Printers travel a little past the bed's shape, and stock blocks use it: the MK3S's purge
+    // line starts at Y-3. More than 5 mm off is a block written for another printer.
+    if (!moved_xy || on_bed(m.to, c, 5.0)) continue;
     char buf[120];
     std::snprintf(buf, sizeof buf, ": line %d goes to X%.3f Y%.3f, off the bed; ", m.line - skip,
                   m.to.x(), m.to.y());
@@ -280,10 +352,84 @@ class Emitter {
 
 }  // namespace
 
+namespace {
+
+// The custom blocks of one print, expanded for it.
+struct Blocks {
+  std::string start, end, start_filament, end_filament;
+};
+
+// Expands start, end and filament blocks with the print's facts and checks what a printer
+// would be sent: printable lines, nothing left unexpanded, moves on the bed, and an E mode
+// that agrees with use_relative_e_distances (a block's M83 under absolute E would make every
+// later E value a huge extrusion).
+Expected<Blocks> expand_blocks(const PrintConfig& c, const PrintFacts& f) {
+  MacroVariables v = block_variables(c, f);
+  Blocks b;
+  auto one = [&](std::string& out, const std::string& text, const char* key) -> Expected<void> {
+    auto e = expand(text, v, key);
+    if (!e) return e.error();
+    out = std::move(*e);
+    return {};
+  };
+  const GcodeParams& g = c.gcode;
+  if (auto e = one(b.start, g.start_gcode, "start_gcode"); !e) return e.error();
+  if (auto e = one(b.start_filament, g.start_filament_gcode, "start_filament_gcode"); !e)
+    return e.error();
+  v.set("layer_num", MacroValue::integer(std::max(0, f.layers - 1)));
+  if (auto e = one(b.end_filament, g.end_filament_gcode, "end_filament_gcode"); !e)
+    return e.error();
+  if (auto e = one(b.end, g.end_gcode, "end_gcode"); !e) return e.error();
+  for (const auto& [key, block] : {std::pair{"start_gcode", &b.start},
+                                   {"end_gcode", &b.end},
+                                   {"start_filament_gcode", &b.start_filament},
+                                   {"end_filament_gcode", &b.end_filament}}) {
+    if (const std::string bad = unprintable_line(*block); !bad.empty())
+      return Error{Status::invalid_argument, std::string(key) + ": " + bad};
+    const std::string left = leftover_placeholder(*block);
+    if (!left.empty())
+      return Error{Status::invalid_argument, std::string(key) + ": " + left +
+                                                 " is not a placeholder this writer knows; edit it "
+                                                 "out, or slice with --engine prusaslicer"};
+    if (has_command(*block, g.relative_e ? "M82" : "M83"))
+      return Error{Status::invalid_argument,
+                   std::string(key) + ": sets " + (g.relative_e ? "absolute" : "relative") +
+                       " extrusion (" + (g.relative_e ? "M82" : "M83") +
+                       ") but use_relative_e_distances is " + (g.relative_e ? "1" : "0")};
+  }
+  if (auto e = check_block_on_bed("start_gcode", b.start, "", c)) return *e;
+  char at[80];  // the end block starts over the print, somewhere on the bed
+  std::snprintf(at, sizeof at, "G92 X%g Y%g Z%g\n", 0.5 * (f.first_min.x() + f.first_max.x()),
+                0.5 * (f.first_min.y() + f.first_max.y()), f.max_layer_z);
+  if (auto e = check_block_on_bed("end_gcode", b.end, at, c)) return *e;
+  return b;
+}
+
+// before_layer_gcode / layer_gcode for layer i (layer_num from 0, as PrusaSlicer).
+Expected<std::string> layer_block(const std::string& text, const char* key, MacroVariables& v,
+                                  std::size_t i, const LayerToolpaths& L, double& max_z) {
+  if (text.empty()) return std::string();
+  max_z = std::max({max_z, L.z, L.max_z});
+  v.set("layer_num", MacroValue::integer(static_cast<long long>(i)));
+  v.set("layer_z", MacroValue::real(L.z));
+  v.set("max_layer_z", MacroValue::real(max_z));
+  auto e = expand(text, v, key);
+  if (!e) return Error{e.error().status, e.error().message + " (layer " + std::to_string(i) + ")"};
+  if (const std::string bad = unprintable_line(*e); !bad.empty())
+    return Error{Status::invalid_argument, std::string(key) + ": " + bad};
+  return e;
+}
+
+}  // namespace
+
 Expected<std::string> make_gcode(const std::vector<LayerToolpaths>& layers, const PrintConfig& c,
                                  const std::vector<std::string>& header, const Context& ctx) {
   const GcodeParams& g = c.gcode;
-  if (auto e = check_custom_gcode(c); !e) return e.error();
+  const PrintFacts facts = facts_of(layers, c);
+  auto blocks = expand_blocks(c, facts);
+  if (!blocks) return blocks.error();
+  MacroVariables layer_vars = block_variables(c, facts);
+  double max_z = 0;
   Emitter em(c);
   em.out().reserve(1 << 20);
   em.comment(" generated by nonplanar 0.1.0");
@@ -291,13 +437,14 @@ Expected<std::string> make_gcode(const std::vector<LayerToolpaths>& layers, cons
   em.line(";FLAVOR:%s", flavor_name(g.flavor));
   em.line("M140 S%g", g.first_layer_bed_temperature);
   em.line("M104 S%g", g.first_layer_temperature);
-  const std::string start = expand(g.start_gcode, c);
+  const std::string& start = blocks->start;
   if (!has_command(start, "M190")) em.line("M190 S%g", g.first_layer_bed_temperature);
   if (!has_command(start, "M109")) em.line("M109 S%g", g.first_layer_temperature);
   em.line("G21 ; millimetres");
   em.line("G90 ; absolute XYZ");
   em.line(g.relative_e ? "M83 ; relative E" : "M82 ; absolute E");
   em.raw(start);
+  em.raw(blocks->start_filament);
   em.line("G92 E0");
   double filament = 0;
   for (std::size_t i = 0; i < layers.size(); ++i) {
@@ -306,7 +453,13 @@ Expected<std::string> make_gcode(const std::vector<LayerToolpaths>& layers, cons
     em.comment("LAYER_CHANGE");
     em.line(";Z:%.3f", L.z);
     em.line(";HEIGHT:%.3f", L.height);
+    auto before = layer_block(g.before_layer_gcode, "before_layer_gcode", layer_vars, i, L, max_z);
+    if (!before) return before.error();
+    em.raw(*before);
     em.reset_e();
+    auto after = layer_block(g.layer_gcode, "layer_gcode", layer_vars, i, L, max_z);
+    if (!after) return after.error();
+    em.raw(*after);
     if (i == 1) {
       if (g.temperature != g.first_layer_temperature) em.line("M104 S%g", g.temperature);
       if (g.bed_temperature != g.first_layer_bed_temperature)
@@ -340,7 +493,8 @@ Expected<std::string> make_gcode(const std::vector<LayerToolpaths>& layers, cons
   if (em.fault) return *em.fault;
   if (em.format_fault()) return *em.format_fault();
   em.fan(0);
-  em.raw(expand(g.end_gcode, c));
+  em.raw(blocks->end_filament);
+  em.raw(blocks->end);
   em.line("; filament used [mm] = %.2f", filament);
   em.line("; filament used [cm3] = %.3f",
           filament * M_PI * 0.25 * g.filament_diameter * g.filament_diameter / 1000.0);
@@ -349,22 +503,14 @@ Expected<std::string> make_gcode(const std::vector<LayerToolpaths>& layers, cons
 }
 
 Expected<void> check_custom_gcode(const PrintConfig& c) {
-  const std::string start = expand(c.gcode.start_gcode, c), end = expand(c.gcode.end_gcode, c);
-  for (const auto& [key, block] : {std::pair{"start_gcode", &start}, {"end_gcode", &end}}) {
-    if (const std::string bad = unprintable_line(*block); !bad.empty())
-      return Error{Status::invalid_argument, std::string(key) + ": " + bad};
-    const std::string left = leftover_placeholder(*block);
-    if (!left.empty())
-      return Error{Status::invalid_argument,
-                   std::string(key) + ": " + left +
-                       " is a placeholder or macro the built-in writer cannot fill in (it knows "
-                       "temperatures, layer heights and diameters); edit it out, or slice with "
-                       "--engine prusaslicer"};
-  }
-  if (auto e = check_block_on_bed("start_gcode", start, "", c)) return *e;
-  char at[80];  // the end block starts over the print, somewhere on the bed
-  std::snprintf(at, sizeof at, "G92 X%g Y%g Z10\n", c.bed_center().x(), c.bed_center().y());
-  if (auto e = check_block_on_bed("end_gcode", end, at, c)) return *e;
+  // Before slicing: the footprint is not known yet, so the blocks see the bed's centre and a
+  // 10 mm part; make_gcode expands them again with the print's own facts.
+  PrintFacts f;
+  f.first_min = f.first_max = c.bed_center();
+  f.max_layer_z = 10;
+  f.layers = 1;
+  auto b = expand_blocks(c, f);
+  if (!b) return b.error();
   return {};
 }
 

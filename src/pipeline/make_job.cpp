@@ -13,12 +13,15 @@ SliceJob make_job(const PrintConfig& print, double max_angle_deg) {
   j.layers.layer_height = print.slice.layer_height;
   j.layers.first_layer_height = print.slice.first_layer_height;
   j.layers.max_angle_deg = max_angle_deg;
-  j.layers.min_layer_height = print.min_layer_height > 0
-                                  ? print.min_layer_height
-                                  : std::min(j.analysis.min_layer_height, print.slice.layer_height);
+  // A profile's limits are its variable-layer-height limits; a preset whose own layer height
+  // lies outside them (MK3S's 0.30mm DRAFT under max 0.25) prints that height, so the curved
+  // layers may reach it too.
+  const double h = print.slice.layer_height;
+  j.layers.min_layer_height = print.min_layer_height > 0 ? std::min(print.min_layer_height, h)
+                                                         : std::min(j.analysis.min_layer_height, h);
   j.layers.max_layer_height =
       print.max_layer_height > 0
-          ? print.max_layer_height
+          ? std::max(print.max_layer_height, h)
           : std::min(print.paths.nozzle_diameter,
                      std::max(1.5 * print.slice.layer_height,
                               std::min(0.75 * print.paths.nozzle_diameter, 0.3)));

@@ -129,6 +129,9 @@ Expected<std::vector<SlicedLayer>> slice_mesh(const TriangleMesh& mesh, const Sl
   std::vector<SlicedLayer> layers;
   for (double z0 = box.min.z(), h = p.first_layer_height; z0 < box.max.z() - 1e-9;
        z0 += h, h = p.layer_height) {
+    // As PrusaSlicer: a layer exists only while its mid-plane is inside the part, so the
+    // last layer never overshoots the top by more than half a layer.
+    if (z0 + 0.5 * h >= box.max.z() && !layers.empty()) break;
     SlicedLayer l;
     l.z_bottom = z0;
     l.z_top = z0 + h;

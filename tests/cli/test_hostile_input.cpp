@@ -216,7 +216,7 @@ TEST(HostileInput, LimitsAreErrorsNamingTheKeyOrSizes) {
       {"--max-angle 120", "max_angle"},
       {"--min-layer-height 0.15 --max-layer-height 0.12", "min_layer_height"},
       {"--max-layer-height -0.3", "max_layer_height"},
-      {"--min-layer-height 0.3", "min_layer_height"},
+      {"--max-layer-height 0.6", "max_layer_height"},
   };
   for (const auto& [args, key] : cases) {
     const CliRun r = cli("slice -q " + small + " -o " + out + " " + args);
@@ -226,7 +226,7 @@ TEST(HostileInput, LimitsAreErrorsNamingTheKeyOrSizes) {
     EXPECT_FALSE(fs::exists(out)) << args;
   }
   // The same keys from a profile name the file and line.
-  test::write_bytes(dir / "p.ini", "layer_height = 0.2\nmin_layer_height = 0.25\n");
+  test::write_bytes(dir / "p.ini", "min_layer_height = 0.25\nmax_layer_height = 0.2\n");
   const CliRun ini =
       cli("slice -q " + small + " -o " + out + " --config " + (dir / "p.ini").string());
   EXPECT_EQ(ini.code, 2);
@@ -238,6 +238,12 @@ TEST(HostileInput, LimitsAreErrorsNamingTheKeyOrSizes) {
   ASSERT_EQ(ok.code, 0) << ok.err;
   const std::string g = test::read_bytes(out);
   EXPECT_NE(g.find("h_min 0.120"), std::string::npos);
+  // Limits that leave out the layer height itself are variable-height limits, as in
+  // PrusaSlicer (MK3S's 0.30mm DRAFT under its printer's max 0.25): they widen to reach it.
+  const CliRun wide = cli("slice -q " + (dir / "roof.stl").string() + " -o " + out +
+                          " --layer-height 0.2 --min-layer-height 0.25 --max-layer-height 0.3");
+  ASSERT_EQ(wide.code, 0) << wide.err;
+  EXPECT_NE(test::read_bytes(out).find("h_min 0.200"), std::string::npos);
   // Hostile-input #17: a max_angle just under 90 was accepted and then every slice failed
   // the safety gate (exit 1). Now the head's cone bounds it, and the slice works.
   const CliRun steep = cli("slice -q " + (dir / "roof.stl").string() + " -o " + out +

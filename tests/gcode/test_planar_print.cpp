@@ -207,16 +207,18 @@ TEST(PlanarPrint, CustomGcodeIsCheckedNotPassedRaw) {
   const Printed own = print(test::box({0, 0, 0}, {10, 10, 1}), start_of("M190 S70\nG28\n"));
   EXPECT_EQ(own.text.find("M190 S60"), std::string::npos);  // the profile waits itself
   EXPECT_NE(own.text.find("M109 S215"), std::string::npos);
-  EXPECT_TRUE(check_custom_gcode(start_of("G28 ; [printer_model] {if x}\n")));
-  for (const char* bad : {"G1 Z{max_layer_z}\n", "M862.3 P \"[printer_model]\"\n",
-                          "{if layer_height<0.075}M221 S100{else}M221 S95{endif}\n"}) {
+  // Macros are expanded (config/test_macros.cpp); what cannot be is refused, never sent raw.
+  for (const char* bad : {"G28 ; {if x}\n", "G1 Z{max_layer_zz}\n", "M862.3 P \"[printer_mode]\"\n",
+                          "{if layer_height<0.075}M221 S100{else}M221 S95\n"}) {
     auto r = check_custom_gcode(start_of(bad));
     ASSERT_FALSE(r) << bad;
-    EXPECT_EQ(r.error().message.rfind("start_gcode: ", 0), 0u) << r.error().message;
+    EXPECT_EQ(r.error().message.rfind("start_gcode: line 1: ", 0), 0u) << r.error().message;
   }
   PrintConfig end;
-  end.gcode.end_gcode = "G1 X0 Y200 Z{max_layer_z}\n";
-  EXPECT_FALSE(check_custom_gcode(end));
+  end.gcode.end_gcode = "G1 X0 Y200 Z{max_layer_z+1}\n";
+  ASSERT_TRUE(check_custom_gcode(end));
+  const Printed lifted = print(test::box({0, 0, 0}, {10, 10, 1}), end);
+  EXPECT_NE(lifted.text.find("\nG1 X0 Y200 Z2\n"), std::string::npos);  // 1 mm over the top
   // Found by the settings fuzzer: binary bytes in end_gcode went to the printer raw.
   end.gcode.end_gcode = "M104 S0\nM84 \xb7\xb7\n";
   auto binary = check_custom_gcode(end);

@@ -1,0 +1,127 @@
+// Stock vendor presets by name, as a new user picks them: the built-in route expands their
+// start, end and layer blocks the way PrusaSlicer does (every line we send for them is a line
+// PrusaSlicer sends for the same presets and part). Skipped without Debian's prusa-slicer.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include "nonplanar/io.hpp"
+#include "nonplanar/presets.hpp"
+#include "support/cli.hpp"
+
+namespace nonplanar {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Stock {
+  const char *printer, *print, *filament;
+};
+
+const Stock kStock[] = {
+    {"Original Prusa i3 MK3S & MK3S+", "0.20mm QUALITY @MK3", "Prusament PLA"},
+    {"Original Prusa i3 MK3S & MK3S+", "0.07mm ULTRADETAIL @MK3", "Prusament PLA"},
+    {"Creality Ender-3 (0.4 mm nozzle)", "0.16 mm OPTIMAL (0.4 mm nozzle) @CREALITY",
+     "Generic PLA @CREALITY"},
+    {"Voron_v2_250 0.4 nozzle", "0.15mm 0.4nozzle V2", "Basic PLA @VORON"},
+};
+
+bool have_bundles() {
+  return std::system("command -v prusa-slicer >/dev/null 2>&1") == 0 &&
+         fs::exists(fs::path(kDefaultProfilesDir) / "PrusaResearch.ini");
+}
+
+std::vector<std::string> lines_of(const std::string& text) {
+  std::vector<std::string> out;
+  std::stringstream ss(text);
+  for (std::string l; std::getline(ss, l);) out.push_back(l);
+  return out;
+}
+
+// The lines before the first layer and after the last one (the custom blocks live there).
+void split(const std::string& text, std::vector<std::string>& head,
+           std::vector<std::string>& tail) {
+  const auto ls = lines_of(text);
+  std::size_t first = ls.size(), last = 0;
+  for (std::size_t i = 0; i < ls.size(); ++i)
+    if (ls[i] == ";LAYER_CHANGE") first = std::min(first, i), last = i;
+  head.assign(ls.begin(), ls.begin() + static_cast<long>(std::min(first, ls.size())));
+  std::size_t end_of_last = last;
+  while (end_of_last < ls.size() && ls[end_of_last].rfind("; filament used", 0) != 0) ++end_of_last;
+  tail.assign(ls.begin() + static_cast<long>(last), ls.begin() + static_cast<long>(end_of_last));
+}
+
+std::string quoted(const std::string& s) {
+  return "'" + s + "'";
+}
+
+TEST(StockPresets, BlocksMatchPrusaSlicersOwnExpansion) {
+  if (!have_bundles()) GTEST_SKIP() << "prusa-slicer or its vendor bundles not installed";
+  const fs::path dir = test::temp_dir("stock_presets");
+  const fs::path stl = dir / "box.stl";
+  ASSERT_TRUE(write_stl(stl, test::box({0, 0, 0}, {20, 20, 10})));
+  for (const Stock& s : kStock) {
+    SCOPED_TRACE(s.printer + std::string(" / ") + s.print);
+    // PrusaSlicer with the same presets, resolved into one file.
+    std::map<std::string, std::string> merged;  // later presets win, as in PrusaSlicer
+    for (const auto& [type, name] :
+         {std::pair{"printer", s.printer}, {"print", s.print}, {"filament", s.filament}}) {
+      auto keys = find_preset(kDefaultProfilesDir, type, name);
+      ASSERT_TRUE(keys) << keys.error().message;
+      for (const auto& [k, v] : *keys) merged[k] = v;
+    }
+    {
+      std::ofstream ini(dir / "preset.ini");
+      for (const auto& [k, v] : merged) ini << k << " = " << v << "\n";
+    }
+    const fs::path theirs = dir / "theirs.gcode", ours = dir / "ours.gcode";
+    const std::string ps = "prusa-slicer --export-gcode --load " + (dir / "preset.ini").string() +
+                           " --output " + theirs.string() + " " + stl.string() + " >" +
+                           (dir / "ps.log").string() + " 2>&1";
+    ASSERT_EQ(std::system(ps.c_str()), 0) << test::read_bytes(dir / "ps.log");
+    const auto r =
+        test::run_cli("slice " + stl.string() + " --planar -q --printer-profile " +
+                      quoted(s.printer) + " --print-profile " + quoted(s.print) +
+                      " --material-profile " + quoted(s.filament) + " -o " + ours.string());
+    ASSERT_EQ(r.code, 0) << r.err;
+    std::vector<std::string> our_head, our_tail, their_head, their_tail;
+    split(test::read_bytes(ours), our_head, our_tail);
+    split(test::read_bytes(theirs), their_head, their_tail);
+    const std::set<std::string> head(their_head.begin(), their_head.end()),
+        tail(their_tail.begin(), their_tail.end());
+    // Our own framing (header comments, temperatures, modes) is ours; every other line is
+    // a profile block's, and must be PrusaSlicer's line.
+    int checked = 0;
+    for (const std::string& l : our_head) {
+      if (l.empty() || l[0] == ';' || l.rfind("G21 ;", 0) == 0 ||
+          l.rfind("G90 ; absolute", 0) == 0 || l.rfind("M8", 0) == 0 || l.rfind("M1", 0) == 0 ||
+          l == "G92 E0")
+        continue;
+      EXPECT_TRUE(head.count(l)) << "start: '" << l << "' is not in PrusaSlicer's start";
+      ++checked;
+    }
+    // Our end: what follows the fan going off after the last layer's paths.
+    const auto off = std::find(our_tail.begin(), our_tail.end(), "M107");
+    ASSERT_NE(off, our_tail.end());
+    for (auto it = off + 1; it != our_tail.end(); ++it) {
+      const std::string& l = *it;
+      if (l.empty() || l[0] == ';') continue;
+      EXPECT_TRUE(tail.count(l) || head.count(l))
+          << "end: '" << l << "' is not in PrusaSlicer's end";
+      ++checked;
+    }
+    EXPECT_GE(checked, 2);
+    // Nothing unexpanded anywhere outside comments.
+    for (const std::string& l : lines_of(test::read_bytes(ours))) {
+      const std::string code = l.substr(0, l.find(';'));
+      EXPECT_EQ(code.find_first_of("{}[]"), std::string::npos) << l;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace nonplanar
