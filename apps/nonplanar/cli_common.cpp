@@ -15,6 +15,7 @@
 #include "core/atomic_file.hpp"
 #include "core/sanitizers.hpp"
 #include "engine/external_engine.hpp"
+#include "nonplanar/unsupported_keys.hpp"
 
 namespace nonplanar::cli {
 namespace {
@@ -176,7 +177,7 @@ Expected<Setting> apply_setting(PrintConfig& c, const std::string& kv, bool unkn
   auto r = set_config_value(c, p.key, p.value);
   if (!r) return Error{Status::invalid_argument, "--" + r.error().message};
   p.known = *r;
-  if (!p.known && !unknown_ok)
+  if (!p.known && !unknown_ok && !is_unsupported_key(p.key))
     return Error{Status::invalid_argument, "unknown setting '" + p.key + "'"};
   return p;
 }

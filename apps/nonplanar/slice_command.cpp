@@ -7,9 +7,22 @@
 #include "commands.hpp"
 #include "nonplanar/gcode.hpp"
 #include "nonplanar/pipeline.hpp"
+#include "nonplanar/unsupported_keys.hpp"
 
 namespace nonplanar::cli {
 namespace {
+
+// One line naming what the profile asks for and the built-in engine does not print.
+void warn_unsupported(const PrintConfig& cfg) {
+  const auto keys = unsupported_settings(cfg);
+  if (keys.empty()) return;
+  std::string list;
+  for (const auto& k : keys) list += (list.empty() ? "" : ", ") + k;
+  std::fprintf(stderr,
+               "warning: the built-in engine does not print %s; they are left out "
+               "(--engine prusaslicer prints them)\n",
+               list.c_str());
+}
 
 struct SliceOptions {
   MeshOptions mesh;
@@ -65,7 +78,7 @@ int run(const SliceOptions& o) {
     // A key only the engine knows (brim_width, support_material, ...) goes to it alone.
     auto applied = apply_setting(cfg, kv, engine.engine != Engine::builtin);
     if (!applied) return report_error(applied.error());
-    if (!applied->known) engine_only.push_back(applied->key);
+    if (!applied->known && engine.engine != Engine::builtin) engine_only.push_back(applied->key);
     if (!is_nonplanar_key(applied->key))
       engine.overrides.emplace_back(std::move(applied->key), std::move(applied->value));
   }
@@ -73,6 +86,7 @@ int run(const SliceOptions& o) {
   if (auto a = check_max_angle(o.max_angle); !a) return report_error(a.error());
   if (!o.mesh.quiet) {
     for (const auto& n : cfg.notes) std::fprintf(stderr, "warning: %s\n", n.c_str());
+    if (engine.engine == Engine::builtin) warn_unsupported(cfg);
     for (const auto& k : engine_only)
       std::fprintf(stderr,
                    "notice: %s is passed to %s only (the built-in engine has no such "
