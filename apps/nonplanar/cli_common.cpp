@@ -15,6 +15,7 @@
 #include "core/atomic_file.hpp"
 #include "core/sanitizers.hpp"
 #include "engine/external_engine.hpp"
+#include "nonplanar/macros.hpp"
 #include "nonplanar/unsupported_keys.hpp"
 
 namespace nonplanar::cli {
@@ -241,6 +242,25 @@ bool same_file(const std::string& a, const std::string& b) {
   return !ec && ca == cb;
 }
 }  // namespace
+
+Expected<std::string> output_path(const std::string& output, const std::string& model,
+                                  const PrintConfig& cfg) {
+  namespace fs = std::filesystem;
+  std::string out = output;
+  std::error_code ec;
+  if (!out.empty() && (out.back() == '/' || fs::is_directory(out, ec)))
+    out = (fs::path(out) / "[input_filename_base].gcode").string();
+  if (out.find_first_of("[{") == std::string::npos) return out;
+  MacroVariables vars = profile_variables(cfg);
+  const fs::path in(model);
+  vars.set("input_filename_base", MacroValue::text(in.stem().string()));
+  vars.set("input_filename", MacroValue::text(in.filename().string()));
+  auto e = expand_macros(out, vars, "output name");
+  if (!e) return Error{Status::invalid_argument, "-o " + output + ": " + e.error().message};
+  if (e->empty() || e->back() == '/')
+    return Error{Status::invalid_argument, "-o " + output + ": names no file"};
+  return *e;
+}
 
 Expected<void> check_outputs(const std::vector<std::string>& inputs,
                              const std::vector<std::string>& outputs) {

@@ -95,6 +95,13 @@ void add_analysis_options(CLI::App& cmd, AnalysisParams& p);
 
 /// Refuses to write any output over an input or over another output (the same file by any
 /// name: a link, "./x", an absolute path). Empty names are ignored. The error names both.
+/// The file `-o OUTPUT` names for `model`: a folder (an existing one, or a path ending in '/')
+/// gets "[input_filename_base].gcode" in it, and PrusaSlicer's output-name macros are
+/// expanded ([input_filename_base], [input_filename], any profile key: [layer_height]).
+/// Error: "-o OUTPUT: problem" (an unknown variable, for example).
+Expected<std::string> output_path(const std::string& output, const std::string& model,
+                                  const PrintConfig& cfg);
+
 Expected<void> check_outputs(const std::vector<std::string>& inputs,
                              const std::vector<std::string>& outputs);
 

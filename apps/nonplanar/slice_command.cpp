@@ -38,10 +38,8 @@ struct SliceOptions {
   std::vector<std::string> sets;
 };
 
-int run(const SliceOptions& o) {
-  std::vector<std::string> inputs = o.config;
-  inputs.insert(inputs.end(), {o.mesh.model, o.engine_config, o.engine_filaments, o.engine_path});
-  if (auto c = check_outputs(inputs, {o.output}); !c) return report_error(c.error());
+int run(const SliceOptions& opts) {
+  SliceOptions o = opts;  // o.output becomes the file -o names, once the profile is known
   PrintConfig cfg;
   EngineParams engine;
   if (o.engine == "prusaslicer")
@@ -84,6 +82,12 @@ int run(const SliceOptions& o) {
   }
   if (auto v = validate_config(cfg); !v) return report_error(v.error());
   if (auto a = check_max_angle(o.max_angle); !a) return report_error(a.error());
+  auto out = output_path(o.output, o.mesh.model, cfg);
+  if (!out) return report_error(out.error());
+  o.output = *out;
+  std::vector<std::string> inputs = o.config;
+  inputs.insert(inputs.end(), {o.mesh.model, o.engine_config, o.engine_filaments, o.engine_path});
+  if (auto c = check_outputs(inputs, {o.output}); !c) return report_error(c.error());
   if (!o.mesh.quiet) {
     for (const auto& n : cfg.notes) std::fprintf(stderr, "warning: %s\n", n.c_str());
     if (engine.engine == Engine::builtin) warn_unsupported(cfg);
@@ -150,7 +154,10 @@ void register_slice(CLI::App& app, std::function<int()>* run_fn) {
       "with a 220 x 220 mm bed; --config loads a JSON profile or a PrusaSlicer .ini, and\n"
       "the options below (or --set KEY=VALUE with any PrusaSlicer key) override it.");
   o->mesh.add_to(*cmd);
-  cmd->add_option("-o,--output", o->output, "G-code file to write (atomically)")->required();
+  cmd->add_option("-o,--output", o->output,
+                  "G-code file to write (atomically); a folder gets MODEL.gcode in it, and "
+                  "PrusaSlicer's name macros are expanded ([input_filename_base], {layer_height})")
+      ->required();
   o->presets.add_to(*cmd);
   cmd->add_option("--load,--config", o->config,
                   "Profile: .json or PrusaSlicer .ini; repeat it for a printer, a print and a\n"

@@ -15,6 +15,7 @@
 #include <string_view>
 #include <vector>
 
+#include "nonplanar/config.hpp"
 #include "nonplanar/status.hpp"
 
 namespace nonplanar {
@@ -56,5 +57,11 @@ class MacroVariables {
 /// "BLOCK: line N: problem", e.g. "end_gcode: line 1: 'max_layer_zz' is not a variable".
 Expected<std::string> expand_macros(std::string_view text, const MacroVariables& vars,
                                     const std::string& block);
+
+/// The variables a profile's macros see before printing: PrusaSlicer's defaults for keys a
+/// profile may leave out (printer_model "", filament_type "PLA", ...), every key of
+/// `c.profile`, the values we resolved from them (layer_height, temperature[0], the
+/// widths), and the bed (print_bed_min/max/size). The writer adds the print's facts.
+MacroVariables profile_variables(const PrintConfig& c);
 
 }  // namespace nonplanar
