@@ -9,6 +9,7 @@
 #include "nonplanar/check.hpp"
 #include "nonplanar/config.hpp"
 #include "nonplanar/deform.hpp"
+#include "nonplanar/macros.hpp"
 #include "nonplanar/surface_io.hpp"
 #include "nonplanar/toolhead.hpp"
 
@@ -153,8 +154,19 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     return 0;
   }
   check_settings_output(*text, *c);
+#elif NONPLANAR_FUZZ_PARSER == 11
+  // A custom G-code block: expanded or an error, with the variables a real print has.
+  static const MacroVariables vars = [] {
+    PrintConfig c;
+    (void)set_config_value(c, "temperature", "210,200");
+    (void)set_config_value(c, "printer_notes", "PRINTER_VENDOR_PRUSA3D\\nPRINTER_MODEL_MK3\\n");
+    MacroVariables v = profile_variables(c);
+    v.set("max_layer_z", MacroValue::real(23.45));
+    return v;
+  }();
+  (void)expand_macros(in, vars, "start_gcode");
 #else
-#error "NONPLANAR_FUZZ_PARSER must name a parser (0-10)"
+#error "NONPLANAR_FUZZ_PARSER must name a parser (0-11)"
 #endif
   return 0;
 }

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Run the libFuzzer targets (one per parser; AddressSanitizer + UndefinedBehaviorSanitizer).
 # Usage: fuzz/run.sh [SECONDS=60] [TARGET...]
-#   TARGET: stl obj off 3mf ini json surfaces gcode foreign toolhead settings (default: all
+#   TARGET: stl obj off 3mf ini json surfaces gcode foreign toolhead settings macros (default: all
 #   of them, two at a time; foreign is the mapping of another slicer's G-code,
 #   map_foreign_gcode; toolhead is a head shape file, docs/toolhead.md; settings prints a box
 #   with any profile that validates and checks the G-code stays on the bed and in range).
@@ -15,7 +15,7 @@ cd "$(dirname "$0")/.."
 secs=${1:-60}
 shift || true
 targets=("$@")
-((${#targets[@]})) || targets=(stl obj off 3mf ini json surfaces gcode foreign toolhead settings)
+((${#targets[@]})) || targets=(stl obj off 3mf ini json surfaces gcode foreign toolhead settings macros)
 out=${BUILD_DIR:-build-san}
 missing=0
 for t in "${targets[@]}"; do [[ -x "$out/fuzz/fuzz_$t" ]] || missing=1; done
@@ -38,6 +38,9 @@ seed off "$models"/*.off
 seed ini tests/data/*.ini
 seed settings tests/data/*.ini
 seed toolhead toolheads/*.json
+mkdir -p "$out/corpus/macros"
+printf '%s' 'M862.3 P "[printer_model]"\n{if max_layer_z < 200}G1 Z{z_offset+min(max_layer_z+30, 200)}{else}G1 Z{max_layer_z+1}{endif}\nM104 S[temperature[0]] ; {digits(1.5,2,1)} {printer_notes=~/.*MK3.*/ ? 1 : 0}\n{elsif}' \
+  >"$out/corpus/macros/mk3s.gcode"
 mkdir -p "$out/corpus/json" "$out/corpus/surfaces" "$out/corpus/gcode" "$out/corpus/3mf" \
   "$out/corpus/foreign" "$out/corpus/settings"
 printf 'skirts = 3\nskirt_distance = 30\nbed_shape = 0x0,80x0,80x80,0x80\ntravel_speed = 900\nmax_fan_speed = 100\nextrusion_multiplier = 4.9\nfirst_layer_extrusion_width = 200%%\nlayer_height = 0.05\n' \

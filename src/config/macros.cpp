@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <regex>
 #include <sstream>
 
@@ -71,6 +72,16 @@ class Expression {
   std::string_view s_;
   const MacroVariables& vars_;
   std::size_t p_ = 0;
+  int depth_ = 0;  // nesting of (…), unary operators and ?: (each costs stack)
+
+  // Hostile input (#21): "((((…" or "- - - …" thousands deep would overflow the stack.
+  struct Nest {
+    explicit Nest(int& d) : d_(d) {
+      if (++d_ > 400) throw Fail{"expression nested too deeply"};
+    }
+    ~Nest() { --d_; }
+    int& d_;
+  };
 
   void skip_space() {
     while (p_ < s_.size() && std::isspace(static_cast<unsigned char>(s_[p_]))) ++p_;
@@ -89,6 +100,7 @@ class Expression {
   }
 
   MacroValue conditional() {
+    const Nest nest(depth_);
     MacroValue c = logical_or();
     if (!eat("?")) return c;
     MacroValue a = conditional();
@@ -152,6 +164,8 @@ class Expression {
     if (p_ >= s_.size()) throw Fail{"unterminated /regex/"};
     ++p_;
     if (a.type != Type::text) throw Fail{"=~ needs a string on its left"};
+    // std::regex recurses per character: bound what a profile can make it chew on.
+    if (re.size() > 1000 || a.s.size() > 10000) throw Fail{"=~: string or /regex/ too long"};
     try {
       return std::regex_match(a.s, std::regex(re));
     } catch (const std::regex_error&) {
@@ -192,20 +206,8 @@ class Expression {
       throw Fail{std::string("'") + op + "' needs numbers, not " + to_text(a) + " and " +
                  to_text(b)};
     if ((op == '/' || op == '%') && as_real(b) == 0) throw Fail{"division by zero"};
-    if (a.type == Type::integer && b.type == Type::integer) {
-      switch (op) {
-        case '+':
-          return MacroValue::integer(a.i + b.i);
-        case '-':
-          return MacroValue::integer(a.i - b.i);
-        case '*':
-          return MacroValue::integer(a.i * b.i);
-        case '/':
-          return MacroValue::integer(a.i / b.i);
-        default:
-          return MacroValue::integer(a.i % b.i);
-      }
-    }
+    if (a.type == Type::integer && b.type == Type::integer)
+      return MacroValue::integer(checked(a.i, b.i, op));
     const double x = as_real(a), y = as_real(b);
     switch (op) {
       case '+':
@@ -220,10 +222,37 @@ class Expression {
         return MacroValue::real(std::fmod(x, y));
     }
   }
+  // Whole-number arithmetic without overflow (undefined in C++): an error instead.
+  static long long checked(long long x, long long y, char op) {
+    long long r = 0;
+    bool over = false;
+    switch (op) {
+      case '+':
+        over = __builtin_add_overflow(x, y, &r);
+        break;
+      case '-':
+        over = __builtin_sub_overflow(x, y, &r);
+        break;
+      case '*':
+        over = __builtin_mul_overflow(x, y, &r);
+        break;
+      default:  // '/' and '%'; y != 0 was checked
+        over = x == std::numeric_limits<long long>::min() && y == -1;
+        if (!over) r = op == '/' ? x / y : x % y;
+    }
+    if (over) throw Fail{"whole-number overflow"};
+    return r;
+  }
+  static long long whole(double v, const std::string& fn) {
+    if (!(std::abs(v) < 9e18))
+      throw Fail{fn + "(): " + to_text(MacroValue::real(v)) + " is out of range"};
+    return static_cast<long long>(v);
+  }
   MacroValue unary() {
+    const Nest nest(depth_);
     if (eat("-")) {
       MacroValue v = unary();
-      if (v.type == Type::integer) return MacroValue::integer(-v.i);
+      if (v.type == Type::integer) return MacroValue::integer(checked(0, v.i, '-'));
       if (v.type == Type::real) return MacroValue::real(-v.d);
       throw Fail{"cannot negate " + to_text(v)};
     }
@@ -309,11 +338,11 @@ class Expression {
     }
     if (name == "int") {
       need(1, 1);
-      return MacroValue::integer(static_cast<long long>(as_real(args[0])));
+      return MacroValue::integer(whole(as_real(args[0]), name));
     }
     if (name == "round") {
       need(1, 1);
-      return MacroValue::integer(std::llround(as_real(args[0])));
+      return MacroValue::integer(whole(std::round(as_real(args[0])), name));
     }
     if (name == "digits" || name == "zdigits") {
       need(2, 3);

@@ -78,6 +78,22 @@ TEST(Macros, WhatCannotBeEvaluatedIsAnErrorNamingTheLine) {
   EXPECT_EQ(ex("{sqrt(4)}"), "ERROR start_gcode: line 1: 'sqrt' is not a function");
 }
 
+// Hostile profiles (#21): what would overflow the stack or be undefined in C++ is an error.
+TEST(Macros, HostileExpressionsAreErrors) {
+  EXPECT_EQ(ex("{" + std::string(100, '(') + "1" + std::string(100, ')') + "}"), "1");
+  EXPECT_EQ(ex("{" + std::string(100000, '(') + "1}"),
+            "ERROR start_gcode: line 1: expression nested too deeply");
+  EXPECT_EQ(ex("{" + std::string(100000, '-') + "1}"),
+            "ERROR start_gcode: line 1: expression nested too deeply");
+  EXPECT_EQ(ex("{9223372036854775807 > 0}"), "true");
+  EXPECT_EQ(ex("{4000000000 * 4000000000}"), "ERROR start_gcode: line 1: whole-number overflow");
+  EXPECT_EQ(ex("{5000000000000000000 + 5000000000000000000}"),
+            "ERROR start_gcode: line 1: whole-number overflow");
+  EXPECT_EQ(ex("{int(1e300)}"), "ERROR start_gcode: line 1: int(): 1e+300 is out of range");
+  EXPECT_EQ(ex("{round(-1e19)}"), "ERROR start_gcode: line 1: round(): -1e+19 is out of range");
+  EXPECT_EQ(ex("{int(-2.5)} {round(2.5)}"), "-2 3");
+}
+
 TEST(Macros, ProfileKeysReachTheBlocks) {
   // A profile's keys are kept as written, so a block can name any of them.
   auto c = parse_ini_config(
