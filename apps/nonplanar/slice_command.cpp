@@ -38,8 +38,7 @@ struct SliceOptions {
   std::vector<std::string> sets;
 };
 
-int run(const SliceOptions& opts) {
-  SliceOptions o = opts;  // o.output becomes the file -o names, once the profile is known
+int run(const SliceOptions& o) {
   PrintConfig cfg;
   EngineParams engine;
   if (o.engine == "prusaslicer")
@@ -82,12 +81,12 @@ int run(const SliceOptions& opts) {
   }
   if (auto v = validate_config(cfg); !v) return report_error(v.error());
   if (auto a = check_max_angle(o.max_angle); !a) return report_error(a.error());
-  auto out = output_path(o.output, o.mesh.model, cfg);
-  if (!out) return report_error(out.error());
-  o.output = *out;
+  // The file -o names: known once the profile is (its name macros read the profile).
+  const auto output = output_path(o.output, o.mesh.model, cfg);
+  if (!output) return report_error(output.error());
   std::vector<std::string> inputs = o.config;
   inputs.insert(inputs.end(), {o.mesh.model, o.engine_config, o.engine_filaments, o.engine_path});
-  if (auto c = check_outputs(inputs, {o.output}); !c) return report_error(c.error());
+  if (auto c = check_outputs(inputs, {*output}); !c) return report_error(c.error());
   if (!o.mesh.quiet) {
     for (const auto& n : cfg.notes) std::fprintf(stderr, "warning: %s\n", n.c_str());
     if (engine.engine == Engine::builtin) warn_unsupported(cfg);
@@ -121,7 +120,7 @@ int run(const SliceOptions& opts) {
     if (e.status == Status::invalid_mesh) e.message = o.mesh.model + ": " + e.message;
     return finish_progress(), report_error(e);
   }
-  auto w = write_gcode_text(o.output, result->gcode, ctx);
+  auto w = write_gcode_text(*output, result->gcode, ctx);
   finish_progress();
   if (!w) return report_error(w.error());
   report_warnings(o.mesh.model, *loaded, o.mesh.quiet);
@@ -136,7 +135,7 @@ int run(const SliceOptions& opts) {
     std::fprintf(stderr,
                  "wrote %s: %zu layers, %s, layer thickness %.3f-%.3f mm, "
                  "steepest extrusion %.1f deg, 0 collisions\n",
-                 o.output.c_str(), result->layers.size(), curved, result->thickness_min,
+                 output->c_str(), result->layers.size(), curved, result->thickness_min,
                  result->thickness_max, result->steepest_deg);
   }
   return kExitOk;

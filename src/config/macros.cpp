@@ -404,30 +404,9 @@ struct Branch {
 
 void MacroVariables::set_from_profile(const std::string& key, const std::string& raw) {
   std::vector<MacroValue> values;
-  auto unescape = [](std::string_view v) {
-    std::string out;
-    for (std::size_t i = 0; i < v.size(); ++i) {
-      if (v[i] == '\\' && i + 1 < v.size()) {
-        const char n = v[++i];
-        out += n == 'n' ? '\n' : n == 't' ? '\t' : n == 'r' ? '\r' : n;
-      } else {
-        out += v[i];
-      }
-    }
-    return out;
-  };
   if (!raw.empty() && raw.front() == '"') {  // "a";"b": one string per extruder
-    std::size_t p = 0;
-    while (p < raw.size() && raw[p] == '"') {
-      std::string item;
-      for (++p; p < raw.size() && raw[p] != '"'; ++p) {
-        if (raw[p] == '\\' && p + 1 < raw.size()) item += raw[p++];
-        item += raw[p];
-      }
-      values.push_back(MacroValue::text(unescape(item)));
-      p = raw.find('"', p + 1);
-      if (p == std::string::npos) break;
-    }
+    for (std::string& item : core::ini_string_list(raw))
+      values.push_back(MacroValue::text(std::move(item)));
     vars_[key] = std::move(values);
     return;
   }
@@ -449,7 +428,7 @@ void MacroVariables::set_from_profile(const std::string& key, const std::string&
                          ? MacroValue::integer(static_cast<long long>(*d))
                          : MacroValue::real(*d));
   }
-  if (!all_numbers) values = {MacroValue::text(unescape(raw))};
+  if (!all_numbers) values = {MacroValue::text(core::unescape_ini(raw))};
   vars_[key] = std::move(values);
 }
 

@@ -39,32 +39,17 @@ std::optional<double> number_or_percent(const std::string& v, double base) {
   return core::parse_double(s);
 }
 
-// PrusaSlicer stores G-code templates with \n escapes.
+// PrusaSlicer stores G-code templates with \n escapes, some of them quoted.
 std::string unescape(const std::string& v) {
-  std::string out;
-  for (std::size_t i = 0; i < v.size(); ++i) {
-    if (v[i] == '\\' && i + 1 < v.size()) {
-      const char n = v[++i];
-      out += n == 'n' ? '\n' : n == 't' ? '\t' : n == 'r' ? '\r' : n;
-    } else {
-      out += v[i];
-    }
-  }
+  std::string out = core::unescape_ini(v);
   if (out.size() >= 2 && out.front() == '"' && out.back() == '"')
     out = out.substr(1, out.size() - 2);
   return out;
 }
 
-// The first string of a per-extruder list as PrusaSlicer writes it ("\"a\";\"b\""), its escapes
-// undone; a value without quotes is one string.
+// The first string of a per-extruder list ("\"M900 K0\";\"…\""), its escapes undone.
 std::string first_string(const std::string& v) {
-  if (v.empty() || v.front() != '"') return unescape(v);
-  std::string item;
-  for (std::size_t p = 1; p < v.size() && v[p] != '"'; ++p) {
-    if (v[p] == '\\' && p + 1 < v.size()) item += v[p++];
-    item += v[p];
-  }
-  return unescape(item);
+  return core::ini_string_list(v).front();
 }
 
 // PrusaSlicer's rules, checked against prusa-slicer 2.5's own G-code header: a width in % is

@@ -72,4 +72,34 @@ Error parse_error_at(int line, const std::string& msg) {
   return Error{Status::parse_error, "line " + std::to_string(line) + ": " + msg};
 }
 
+std::string unescape_ini(std::string_view v) {
+  std::string out;
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    if (v[i] == '\\' && i + 1 < v.size()) {
+      const char n = v[++i];
+      out += n == 'n' ? '\n' : n == 't' ? '\t' : n == 'r' ? '\r' : n;
+    } else {
+      out += v[i];
+    }
+  }
+  return out;
+}
+
+std::vector<std::string> ini_string_list(std::string_view v) {
+  if (v.empty() || v.front() != '"') return {unescape_ini(v)};
+  std::vector<std::string> items;
+  std::size_t p = 0;
+  while (p < v.size() && v[p] == '"') {
+    std::string item;  // the quoted text, escapes intact until unescape_ini
+    for (++p; p < v.size() && v[p] != '"'; ++p) {
+      if (v[p] == '\\' && p + 1 < v.size()) item += v[p++];
+      item += v[p];
+    }
+    items.push_back(unescape_ini(item));
+    p = v.find('"', p + 1);
+    if (p == std::string_view::npos) break;
+  }
+  return items;
+}
+
 }  // namespace nonplanar::core

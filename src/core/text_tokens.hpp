@@ -5,6 +5,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "nonplanar/status.hpp"
 
@@ -35,6 +36,13 @@ class Tokenizer {
   std::size_t pos_ = 0;
   int line_ = 1;
 };
+
+/// PrusaSlicer's escapes in an .ini value undone (\\n, \\t, \\r; a backslash before any other
+/// character keeps that character).
+std::string unescape_ini(std::string_view v);
+/// A per-extruder string list as PrusaSlicer writes it ("\"a\";\"b\""), each item unescaped.
+/// A value that does not start with a quote is one string.
+std::vector<std::string> ini_string_list(std::string_view v);
 
 /// "line N: msg" — the parsers' error text, to be prefixed by the file name by the loader.
 Error parse_error_at(int line, const std::string& msg);

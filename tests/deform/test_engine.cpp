@@ -166,8 +166,8 @@ TEST(EnginePrusaSlicer, EngineOnlyKeysReachTheEngine) {
       << r.err;
   EXPECT_NE(test::read_bytes(out).find("; brim_width = 5\n"), std::string::npos);
   // The built-in engine has no brim: it prints without one and says so (issue #16).
-  r = test::run_cli("slice " + (dir / "b.stl").string() + " --set brim_width=5 -o " +
-                    out.string() + "2");
+  r = test::run_cli("slice " + (dir / "b.stl").string() + " --set brim_width=5 -o " + out.string() +
+                    "2");
   EXPECT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.err.find("does not print brim_width = 5"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("--engine prusaslicer prints them"), std::string::npos) << r.err;
