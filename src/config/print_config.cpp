@@ -278,10 +278,12 @@ Expected<void> validate_config(const PrintConfig& c) {
   const GcodeParams& g = c.gcode;
   const double d = t.nozzle_diameter;
   if (!pos(d, 3)) return bad("nozzle_diameter", "must be in (0, 3] mm");
-  if (!pos(c.slice.layer_height, d))
-    return bad("layer_height", "must be > 0 and at most the nozzle diameter");
-  if (!pos(c.slice.first_layer_height, d))
-    return bad("first_layer_height", "must be > 0 and at most the nozzle diameter");
+  // 0.01 mm: below any printer's Z step that matters (stock profiles go down to 0.025), and
+  // what keeps a "0.3%" first layer from slicing a part into 0.6 µm layers.
+  if (!pos(c.slice.layer_height, d) || c.slice.layer_height < 0.01)
+    return bad("layer_height", "must be 0.01 mm to the nozzle diameter");
+  if (!pos(c.slice.first_layer_height, d) || c.slice.first_layer_height < 0.01)
+    return bad("first_layer_height", "must be 0.01 mm to the nozzle diameter");
   for (const auto& [k, v] : {std::pair{"min_layer_height", c.min_layer_height},
                              {"max_layer_height", c.max_layer_height}})
     if (!std::isfinite(v) || v < 0) return bad(k, "must be a finite number >= 0 (0: automatic)");
@@ -297,6 +299,8 @@ Expected<void> validate_config(const PrintConfig& c) {
         {"external_perimeter_extrusion_width", t.external_perimeter_width, lh},
         {"first_layer_extrusion_width", t.first_layer_width, fh}}) {
     if (!pos(v, 1e3) || v < layer) return bad(k, "must be at least its layer's height");
+    // Stock profiles use at least the nozzle's diameter; a quarter of it is already no line.
+    if (v < 0.25 * d) return bad(k, "must be at least 25 % of the nozzle diameter");
     if (v >= 3 * d) return bad(k, "must be below 3 × the nozzle diameter (as PrusaSlicer)");
   }
   if (t.perimeters < 0 || t.perimeters > 100) return bad("perimeters", "must be 0 to 100");

@@ -312,6 +312,28 @@ struct Blocks {
   std::string start, end, start_filament, end_filament;
 };
 
+// What makes an expanded block unfit to send: a line a printer cannot take, a placeholder
+// left unexpanded, an E mode against use_relative_e_distances (a block's M83 under absolute E
+// would make every later E value a huge extrusion), or a line the one reader refuses.
+std::optional<Error> block_fault(const std::string& key, const std::string& block,
+                                 bool relative_e) {
+  if (const std::string bad = unprintable_line(block); !bad.empty())
+    return Error{Status::invalid_argument, key + ": " + bad};
+  const std::string left = leftover_placeholder(block);
+  if (!left.empty())
+    return Error{Status::invalid_argument, key + ": " + left +
+                                               " is not a placeholder this writer knows; edit it "
+                                               "out, or slice with --engine prusaslicer"};
+  if (has_command(block, relative_e ? "M82" : "M83"))
+    return Error{Status::invalid_argument,
+                 key + ": sets " + (relative_e ? "absolute" : "relative") + " extrusion (" +
+                     (relative_e ? "M82" : "M83") + ") but use_relative_e_distances is " +
+                     (relative_e ? "1" : "0")};
+  if (auto moves = read_gcode_moves(block); !moves)
+    return Error{Status::invalid_argument, key + ": " + moves.error().message};
+  return std::nullopt;
+}
+
 // Expands start, end and filament blocks with the print's facts and checks what a printer
 // would be sent: printable lines, nothing left unexpanded, moves on the bed, and an E mode
 // that agrees with use_relative_e_distances (a block's M83 under absolute E would make every
@@ -336,31 +358,24 @@ Expected<Blocks> expand_blocks(const PrintConfig& c, const PrintFacts& f) {
   for (const auto& [key, block] : {std::pair{"start_gcode", &b.start},
                                    {"end_gcode", &b.end},
                                    {"start_filament_gcode", &b.start_filament},
-                                   {"end_filament_gcode", &b.end_filament}}) {
-    if (const std::string bad = unprintable_line(*block); !bad.empty())
-      return Error{Status::invalid_argument, std::string(key) + ": " + bad};
-    const std::string left = leftover_placeholder(*block);
-    if (!left.empty())
-      return Error{Status::invalid_argument, std::string(key) + ": " + left +
-                                                 " is not a placeholder this writer knows; edit it "
-                                                 "out, or slice with --engine prusaslicer"};
-    if (has_command(*block, g.relative_e ? "M82" : "M83"))
-      return Error{Status::invalid_argument,
-                   std::string(key) + ": sets " + (g.relative_e ? "absolute" : "relative") +
-                       " extrusion (" + (g.relative_e ? "M82" : "M83") +
-                       ") but use_relative_e_distances is " + (g.relative_e ? "1" : "0")};
-  }
+                                   {"end_filament_gcode", &b.end_filament}})
+    if (auto e = block_fault(key, *block, g.relative_e)) return *e;
+  // Every block is read by the one reader, so a line it refuses is named by its block here,
+  // not found later in the print.
   if (auto e = check_block_on_bed("start_gcode", b.start, "", c)) return *e;
-  char at[80];  // the end block starts over the print, somewhere on the bed
+  if (auto e = check_block_on_bed("start_filament_gcode", b.start_filament, "", c)) return *e;
+  char at[80];  // the end blocks start over the print, somewhere on the bed
   std::snprintf(at, sizeof at, "G92 X%g Y%g Z%g\n", 0.5 * (f.first_min.x() + f.first_max.x()),
                 0.5 * (f.first_min.y() + f.first_max.y()), f.max_layer_z);
+  if (auto e = check_block_on_bed("end_filament_gcode", b.end_filament, at, c)) return *e;
   if (auto e = check_block_on_bed("end_gcode", b.end, at, c)) return *e;
   return b;
 }
 
 // before_layer_gcode / layer_gcode for layer i (layer_num from 0, as PrusaSlicer).
 Expected<std::string> layer_block(const std::string& text, const char* key, MacroVariables& v,
-                                  std::size_t i, const LayerToolpaths& L, double& max_z) {
+                                  std::size_t i, const LayerToolpaths& L, double& max_z,
+                                  bool relative_e) {
   if (text.empty()) return std::string();
   max_z = std::max({max_z, L.z, L.max_z});
   v.set("layer_num", MacroValue::integer(static_cast<long long>(i)));
@@ -368,8 +383,8 @@ Expected<std::string> layer_block(const std::string& text, const char* key, Macr
   v.set("max_layer_z", MacroValue::real(max_z));
   auto e = expand(text, v, key);
   if (!e) return Error{e.error().status, e.error().message + " (layer " + std::to_string(i) + ")"};
-  if (const std::string bad = unprintable_line(*e); !bad.empty())
-    return Error{Status::invalid_argument, std::string(key) + ": " + bad};
+  if (auto bad = block_fault(key, *e, relative_e))
+    return Error{bad->status, bad->message + " (layer " + std::to_string(i) + ")"};
   return e;
 }
 
@@ -406,11 +421,12 @@ Expected<std::string> make_gcode(const std::vector<LayerToolpaths>& layers, cons
     em.comment("LAYER_CHANGE");
     em.line(";Z:%.3f", L.z);
     em.line(";HEIGHT:%.3f", L.height);
-    auto before = layer_block(g.before_layer_gcode, "before_layer_gcode", layer_vars, i, L, max_z);
+    auto before = layer_block(g.before_layer_gcode, "before_layer_gcode", layer_vars, i, L, max_z,
+                              g.relative_e);
     if (!before) return before.error();
     em.raw(*before);
     em.reset_e();
-    auto after = layer_block(g.layer_gcode, "layer_gcode", layer_vars, i, L, max_z);
+    auto after = layer_block(g.layer_gcode, "layer_gcode", layer_vars, i, L, max_z, g.relative_e);
     if (!after) return after.error();
     em.raw(*after);
     if (i == 1) {
@@ -464,6 +480,14 @@ Expected<void> check_custom_gcode(const PrintConfig& c) {
   f.layers = 1;
   auto b = expand_blocks(c, f);
   if (!b) return b.error();
+  MacroVariables v = block_variables(c, f);
+  LayerToolpaths first;
+  first.z = first.max_z = c.slice.first_layer_height;
+  double max_z = 0;
+  for (const auto& [key, text] : {std::pair{"before_layer_gcode", &c.gcode.before_layer_gcode},
+                                  {"layer_gcode", &c.gcode.layer_gcode}})
+    if (auto e = layer_block(*text, key, v, 0, first, max_z, c.gcode.relative_e); !e)
+      return e.error();
   return {};
 }
 

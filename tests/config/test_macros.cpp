@@ -92,6 +92,17 @@ TEST(Macros, HostileExpressionsAreErrors) {
   EXPECT_EQ(ex("{int(1e300)}"), "ERROR start_gcode: line 1: int(): 1e+300 is out of range");
   EXPECT_EQ(ex("{round(-1e19)}"), "ERROR start_gcode: line 1: round(): -1e+19 is out of range");
   EXPECT_EQ(ex("{int(-2.5)} {round(2.5)}"), "-2 3");
+  // Found by the macros fuzzer: a width of 2e17 was cast to int (undefined) before the check.
+  EXPECT_EQ(ex("{digits(1.5, 222222222222222222, 1)}"),
+            "ERROR start_gcode: line 1: digits(): digits out of range");
+  EXPECT_EQ(ex("{zdigits(1.5, 3, -1e300)}"),
+            "ERROR start_gcode: line 1: zdigits(): digits out of range");
+  // A line of brackets was searched to its end once per bracket: 200 000 of them took minutes.
+  const std::string brackets(200000, '[');
+  EXPECT_EQ(ex(brackets), brackets);
+  EXPECT_EQ(ex("{printer_notes=~/(.|.)*(X|Y)/}"), "false");  // exponential in std::regex
+  EXPECT_EQ(ex("{printer_notes=~/.*MK(3|4/}"),
+            "ERROR start_gcode: line 1: /.*MK(3|4/: missing ')'");
 }
 
 TEST(Macros, ProfileKeysReachTheBlocks) {

@@ -110,6 +110,8 @@ TEST(Config, EverySettingHasARange) {
       {"bed_shape", "0x0,1e9x0,1e9x1e9"},
       {"top_solid_layers", "100000"},
       {"first_layer_extrusion_width", "1000%"},
+      {"first_layer_height", "0.3%"},  // fuzz_settings: 0.6 µm layers ordered for minutes
+      {"layer_height", "0.005"},
   };
   for (const auto& [key, value] : cases) {
     PrintConfig c;
@@ -118,6 +120,14 @@ TEST(Config, EverySettingHasARange) {
     ASSERT_FALSE(valid) << key << " = " << value;
     EXPECT_NE(valid.error().message.find(key), std::string::npos) << valid.error().message;
   }
+  PrintConfig thin;  // thinner than its layer is caught first; a fine layer lets this through
+  ASSERT_TRUE(set_config_value(thin, "layer_height", "0.05"));
+  ASSERT_TRUE(set_config_value(thin, "extrusion_width", "0.08"));
+  auto r = validate_config(thin);
+  ASSERT_FALSE(r);
+  EXPECT_EQ(r.error().message, "extrusion_width: must be at least 25 % of the nozzle diameter");
+  ASSERT_TRUE(set_config_value(thin, "extrusion_width", "0.1"));
+  EXPECT_TRUE(validate_config(thin));
 }
 
 TEST(Config, UnknownFillPatternIsAnErrorAndPrusaSlicersAreNoted) {

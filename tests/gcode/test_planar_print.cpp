@@ -231,6 +231,26 @@ TEST(PlanarPrint, CustomGcodeIsCheckedNotPassedRaw) {
   auto long_line = check_custom_gcode(end);
   ASSERT_FALSE(long_line);
   EXPECT_EQ(long_line.error().message, "end_gcode: line 2 is longer than 255 characters");
+  // Found by the settings fuzzer: a filament block's stray quote (an unbalanced ini list) went
+  // into the print, and only the safety check read it back.
+  PrintConfig quote;
+  quote.gcode.end_filament_gcode = "; END gcode for filament\n\"\n";
+  auto stray = check_custom_gcode(quote);
+  ASSERT_FALSE(stray);
+  EXPECT_EQ(stray.error().message, "end_filament_gcode: line 2: '\"' is not a G-code command");
+  quote.gcode.end_filament_gcode.clear();
+  quote.gcode.layer_gcode = ";AFTER_LAYER_CHANGE\n;[layer_z]\nM83\n";
+  auto mode = check_custom_gcode(quote);
+  ASSERT_FALSE(mode);
+  EXPECT_EQ(
+      mode.error().message,
+      "layer_gcode: sets relative extrusion (M83) but use_relative_e_distances is 0 (layer 0)");
+  quote.gcode.layer_gcode.clear();
+  quote.gcode.start_filament_gcode = "M900 K0.05\nG1 X-50 Y10 F3000\n";
+  auto far = check_custom_gcode(quote);
+  ASSERT_FALSE(far);
+  EXPECT_EQ(far.error().message.rfind("start_filament_gcode: line 2 goes to X-50.000", 0), 0u)
+      << far.error().message;
   // The default purge on a 180 mm bed, given as text the way an old profile carries it.
   PrintConfig small = start_of(PrintConfig{}.gcode.start_gcode);
   small.bed_max = Vec2(180, 180);
