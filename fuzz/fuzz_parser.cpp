@@ -115,6 +115,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   (void)parse_surfaces_json(in);
 #elif NONPLANAR_FUZZ_PARSER == 7
   (void)read_gcode_moves(in);
+  (void)parse_ini_config(gcode_config_block(in));  // what `check` reads of a file's settings
 #elif NONPLANAR_FUZZ_PARSER == 8
   static const Wave field;
   (void)map_foreign_gcode(in, field, {}, {});

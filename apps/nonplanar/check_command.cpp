@@ -20,16 +20,29 @@ struct CheckOptions {
   bool json = false;
 };
 
+// The printer a file was sliced for, from its own settings block (PrusaSlicer's, and so our
+// engine route's): its bed centre is where the part was placed. Defaults when it has none or
+// the block does not read (a notice says why).
+PrintConfig file_config(const std::string& file, std::string_view gcode, bool quiet) {
+  const std::string block = gcode_config_block(gcode);
+  if (block.empty()) return {};
+  auto c = parse_ini_config(block);
+  if (c) return std::move(*c);
+  if (!quiet)
+    std::fprintf(stderr, "notice: %s: its settings block is not used: %s\n", file.c_str(),
+                 c.error().message.c_str());
+  return {};
+}
+
 int run(const CheckOptions& o) {
-  auto cfg = o.profile.load();
-  if (!cfg) return report_error(cfg.error());
   if (auto a = check_max_angle(o.max_angle); !a) return report_error(a.error());
+  auto bytes = core::read_file_bytes(o.gcode, 2ull << 30);
+  if (!bytes) return report_error({bytes.error().status, o.gcode + ": " + bytes.error().message});
+  // The file's own settings first; presets, --config and --set go over them.
+  auto cfg = o.profile.load(file_config(o.gcode, bytes->view(), o.mesh.quiet || o.json));
+  if (!cfg) return report_error(cfg.error());
   const CheckParams params = check_params(*cfg, o.max_angle);
   Context ctx = make_context(o.mesh.quiet || o.json);
-  auto bytes = core::read_file_bytes(o.gcode, 2ull << 30);
-  if (!bytes)
-    return finish_progress(),
-           report_error({bytes.error().status, o.gcode + ": " + bytes.error().message});
   auto moves = read_gcode_moves(bytes->view());
   if (!moves)
     return finish_progress(),
@@ -109,7 +122,8 @@ void register_check(CLI::App& app, std::function<int()>* run_fn) {
       "Recompute the quality figures of a G-code file against its mesh (placed as PrusaSlicer\n"
       "places it: XY centre at the bed centre, lowest point at z = 0): top-surface deviation,\n"
       "layer thickness, steepest extrusion, collisions, volume ratio, extrusion outside the\n"
-      "mesh. Works on PrusaSlicer's G-code too. See docs/check.md for how each is computed.");
+      "mesh. Works on PrusaSlicer's G-code too, and reads the bed and printer from its\n"
+      "settings block (the profile options go over it). See docs/check.md for each figure.");
   cmd->add_option("gcode", o->gcode, "G-code file")->required();
   cmd->add_option("--mesh", o->mesh.model, "The mesh it was sliced from")->required();
   o->profile.add_to(*cmd, "bed size, filament, layer height, the toolhead");

@@ -189,8 +189,8 @@ void ProfileOptions::add_keyed(CLI::App& cmd, const std::string& name, const std
   cmd.add_option(name, keyed.back().second, help);
 }
 
-Expected<PrintConfig> ProfileOptions::load() const {
-  PrintConfig cfg;
+Expected<PrintConfig> ProfileOptions::load(PrintConfig base) const {
+  PrintConfig cfg = std::move(base);
   if (auto p = presets.apply(cfg); !p) return p.error();
   for (const std::string& file : config) {
     auto c = load_config(file, std::move(cfg));

@@ -73,8 +73,9 @@ struct ProfileOptions {
   /// Adds option `name` that sets profile key `key`.
   void add_keyed(CLI::App& cmd, const std::string& name, const std::string& key,
                  const std::string& help);
-  /// The profile with the overrides applied and validated; errors name the file or the key.
-  Expected<PrintConfig> load() const;
+  /// The profile over `base`, with the overrides applied and validated; errors name the
+  /// file or the key.
+  Expected<PrintConfig> load(PrintConfig base = {}) const;
 };
 
 /// max_angle in (0, 90) degrees (NaN refused), or the error every subcommand gives.

@@ -88,8 +88,12 @@ int run(const SliceOptions& o) {
   inputs.insert(inputs.end(), {o.mesh.model, o.engine_config, o.engine_filaments, o.engine_path});
   if (auto c = check_outputs(inputs, {*output}); !c) return report_error(c.error());
   if (!o.mesh.quiet) {
-    for (const auto& n : cfg.notes) std::fprintf(stderr, "warning: %s\n", n.c_str());
-    if (engine.engine == Engine::builtin) warn_unsupported(cfg);
+    // What the built-in engine substitutes (a fill pattern it lacks) and leaves out: another
+    // engine does both itself.
+    if (engine.engine == Engine::builtin) {
+      for (const auto& n : cfg.notes) std::fprintf(stderr, "warning: %s\n", n.c_str());
+      warn_unsupported(cfg);
+    }
     for (const auto& k : engine_only)
       std::fprintf(stderr,
                    "notice: %s is passed to %s only (the built-in engine has no such "
@@ -125,7 +129,8 @@ int run(const SliceOptions& o) {
   if (!w) return report_error(w.error());
   report_warnings(o.mesh.model, *loaded, o.mesh.quiet);
   if (!o.mesh.quiet) {
-    for (const auto& n : result->notices) std::fprintf(stderr, "notice: %s\n", n.text.c_str());
+    for (const auto& n : result->notices)
+      if (n.kind != Notice::Kind::summary) std::fprintf(stderr, "notice: %s\n", n.text.c_str());
     char curved[80];
     if (result->shell_layers > 0)
       std::snprintf(curved, sizeof curved, "a curved shell of %d layers", result->shell_layers);
@@ -137,6 +142,8 @@ int run(const SliceOptions& o) {
                  "steepest extrusion %.1f deg, 0 collisions\n",
                  output->c_str(), result->layers.size(), curved, result->thickness_min,
                  result->thickness_max, result->steepest_deg);
+    for (const auto& n : result->notices)  // the last word, after what was written
+      if (n.kind == Notice::Kind::summary) std::fprintf(stderr, "%s\n", n.text.c_str());
   }
   return kExitOk;
 }

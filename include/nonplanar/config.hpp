@@ -135,6 +135,11 @@ Expected<void> validate_config(const PrintConfig& c);
 /// Error: "FILE: line N: problem".
 Expected<PrintConfig> load_config(const std::filesystem::path& file, PrintConfig base = {});
 
+/// The settings block PrusaSlicer writes at the end of its G-code ("; prusaslicer_config =
+/// begin" … "= end", one "; key = value" per line) as .ini text for parse_ini_config; empty
+/// when the file has none (our built-in engine's, OrcaSlicer's).
+std::string gcode_config_block(std::string_view gcode);
+
 /// Parses .ini text / JSON text over `base` (for tests and fuzzing).
 Expected<PrintConfig> parse_ini_config(std::string_view text, PrintConfig base = {});
 Expected<PrintConfig> parse_json_config(std::string_view text, PrintConfig base = {});

@@ -21,6 +21,7 @@ struct Notice {
     none_needed,   ///< no surface needs curved layers: the part slices planar
     none_fit,      ///< no patch could get a stack (a shell may still print it)
     shell,         ///< about a shell: printed, or refused and why
+    summary,       ///< the last word: how many curved patches printed curved, when not all
   };
   Kind kind = Kind::setting;
   int patch = -1;    ///< the patch it is about (-1: the part, or several patches)
@@ -57,7 +58,9 @@ struct SliceResult {
   double thickness_min = 0, thickness_max = 0, steepest_deg = 0;
   std::size_t collisions = 0;
   bool nonplanar = false;
-  int shell_layers = 0;  ///< curved layers of a shell over a planar core (0: none)
+  int shell_layers = 0;    ///< curved layers of a shell over a planar core (0: none)
+  int curved_patches = 0;  ///< patches whose surface needs curved layers (0 with planar_only)
+  int printed_curved = 0;  ///< of those, the ones printed curved (as stacks or in the shell)
   /// The whole program, as the safety gate checked it: the built-in writer's, or an external
   /// engine's (its start and end G-code and settings kept) mapped back. Write it with
   /// write_gcode_text.

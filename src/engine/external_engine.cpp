@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <thread>
 
@@ -180,10 +181,17 @@ Expected<std::string> run_engine(const EngineParams& e, const TriangleMesh& mesh
     };
     {
       std::ofstream ini(forced);
-      for (const auto& [key, value] : e.overrides)
-        if (key != "retract_lift" && key != "spiral_vase" && key != "arc_fitting" &&
-            key != "layer_height" && key != "first_layer_height" && !forced_for_slab(key))
+      // A key once, with its last value: presets by name and --set may both give it, and
+      // PrusaSlicer refuses an ini with a duplicate key.
+      std::map<std::string, std::size_t> last;
+      for (std::size_t i = 0; i < e.overrides.size(); ++i) last[e.overrides[i].first] = i;
+      for (std::size_t i = 0; i < e.overrides.size(); ++i) {
+        const auto& [key, value] = e.overrides[i];
+        if (last[key] == i && key != "retract_lift" && key != "spiral_vase" &&
+            key != "arc_fitting" && key != "layer_height" && key != "first_layer_height" &&
+            !forced_for_slab(key))
           ini << key << " = " << value << "\n";
+      }
       ini << "arc_fitting = disabled\n";
       if (run.slab_layer_height > 0)
         for (const auto& [key, value] : kSlab) ini << key << " = " << value << "\n";

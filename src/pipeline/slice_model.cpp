@@ -79,6 +79,7 @@ Expected<SliceResult> attempt(const TriangleMesh& mesh, const SliceJob& job, con
       normalized = std::move(n->mesh);
       to_slice = &normalized;
       r.nonplanar = true;
+      r.printed_curved = static_cast<int>(r.plan.stacks.size());
       char buf[160];
       for (const LayerStack& st : r.plan.stacks) {
         std::snprintf(buf, sizeof buf, "patch %d: %d curved layers from z = %.2f mm", st.patch,
@@ -177,6 +178,7 @@ Expected<std::optional<SliceResult>> try_shell(const TriangleMesh& mesh, const S
   if (!r.gcode.empty()) r.gcode = engine_header(route, r.header, plan.core.at(1)) + r.gcode;
   r.nonplanar = true;
   r.shell_layers = plan.N;
+  r.printed_curved = static_cast<int>(plan.patches.size());
   std::string breach;
   auto ok = gate(
       r, job, nullptr,
@@ -211,6 +213,12 @@ Expected<SliceResult> slice_rounds(const TriangleMesh& mesh, const SliceJob& job
     if (!fits) return fits.error();
     pre.fits = std::move(*fits);
   }
+  int candidates = 0;
+  for (const Patch& p : pre.analysis.patches) candidates += p.needs_nonplanar();
+  auto done = [&](Expected<SliceResult> r) {
+    if (r) r->curved_patches = candidates;
+    return r;
+  };
   std::vector<int> excluded;
   std::vector<Notice> dropped;
   std::vector<std::pair<int, std::string>> offenders;
@@ -226,16 +234,16 @@ Expected<SliceResult> slice_rounds(const TriangleMesh& mesh, const SliceJob& job
       r->notices.insert(r->notices.begin(), dropped.begin(), dropped.end());
       auto shell = try_shell(mesh, job, pre.analysis, *r, ctx);
       if (!shell) return shell.error();
-      if (*shell) return std::move(**shell);
+      if (*shell) return done(std::move(**shell));
       const std::vector<Notice> notices = std::move(r->notices);
       r = attempt(mesh, job, pre, excluded, &offenders, nullptr, ctx);
       if (!r) return r;
       r->notices = notices;
-      return r;
+      return done(std::move(r));
     }
     if (offenders.empty()) {
       r->notices.insert(r->notices.begin(), dropped.begin(), dropped.end());
-      return r;
+      return done(std::move(r));
     }
     // A stack that met every limit on its own grid broke one in the final paths: print
     // that patch planar rather than refuse the part.
@@ -254,12 +262,32 @@ Expected<SliceResult> slice_rounds(const TriangleMesh& mesh, const SliceJob& job
   return Error{Status::internal_error, "safety check: still failing after dropping 8 patches"};
 }
 
+// When some curved patch printed planar, one line to end on: how many did not, and the first
+// reason given (the notices before it say the rest).
+std::optional<Notice> summary(const SliceResult& r) {
+  if (r.curved_patches == 0 || r.printed_curved >= r.curved_patches) return std::nullopt;
+  std::string why;  // the shell's refusal (the last thing tried), else a patch's own reason
+  for (const Notice& n : r.notices)
+    if (why.empty() && n.kind == Notice::Kind::shell && n.text.find(" not printed") != n.text.npos)
+      why = n.text;
+  for (const Notice& n : r.notices)
+    if (why.empty() && n.kind == Notice::Kind::patch_planar) why = n.text;
+  if (why.size() > 160) why = why.substr(0, 157) + "...";
+  std::string text = std::to_string(r.printed_curved) + " of " + std::to_string(r.curved_patches) +
+                     (r.curved_patches == 1 ? " curved patch" : " curved patches") +
+                     " printed curved";
+  if (r.printed_curved == 0) text += ", the print is planar";
+  if (!why.empty()) text += " (" + why + ")";
+  return Notice{Notice::Kind::summary, -1, text};
+}
+
 }  // namespace
 
 Expected<SliceResult> slice_model(const TriangleMesh& mesh, const SliceJob& job,
                                   const Context& ctx) {
   auto r = slice_rounds(mesh, job, ctx);
   if (!r) return r;
+  if (auto s = summary(*r)) r->notices.push_back(*s);
   if (auto e = nothing_to_print(*r, mesh)) return *e;
   if (auto w = write_program(*r, job, ctx); !w) return w.error();
   r->notices.insert(r->notices.begin(), job.notices.begin(), job.notices.end());

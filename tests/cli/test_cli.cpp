@@ -201,6 +201,38 @@ TEST(Cli, SliceNonPlanarThenCheck) {
   EXPECT_NE(a.err.find("line 3"), std::string::npos) << a.err;
 }
 
+// check places the mesh on the bed the file was sliced for: a PrusaSlicer file says which
+// in its settings block (#16: on a 200 mm bed, check read correct files as 1-40 mm off).
+TEST(Cli, CheckReadsTheBedFromTheFilesSettingsBlock) {
+  const auto dir = test::temp_dir("cli_check_block");
+  ASSERT_TRUE(write_stl(dir / "box.stl", test::box({0, 0, 0}, {20, 20, 5})));
+  const std::string model = (dir / "box.stl").string(), out = (dir / "box.gcode").string();
+  const std::string bed = "bed_shape=0x0,250x0,250x210,0x210";
+  const CliResult s = run("slice -q --planar " + model + " -o " + out + " --set " + bed);
+  ASSERT_EQ(s.code, 0) << s.err;
+  const std::string gcode = test::read_bytes(out);
+  auto outside = [&](const std::string& text, const std::string& opts) {
+    test::write_bytes(dir / "t.gcode", text);
+    const CliResult c =
+        run("check -q --json " + (dir / "t.gcode").string() + " --mesh " + model + opts);
+    EXPECT_EQ(c.code, 0) << c.err;
+    return c.code == 0 ? nlohmann::json::parse(c.out)["outside_fraction"].get<double>() : -1.0;
+  };
+  const std::string block =
+      "; prusaslicer_config = begin\n; bed_shape = 0x0,250x0,250x210,0x210\n"
+      "; layer_height = 0.2\n; prusaslicer_config = end\n";
+  EXPECT_GT(outside(gcode, ""), 0.3);                // placed at (110, 110): 15 mm off
+  EXPECT_LT(outside(gcode + block, ""), 0.01);       // the block's bed: centred at (125, 105)
+  EXPECT_LT(outside(gcode, " --set " + bed), 0.01);  // or the user's
+  const std::string wrong =
+      "; prusaslicer_config = begin\n; bed_shape = 0x0,1x0\n"
+      "; prusaslicer_config = end\n";
+  test::write_bytes(dir / "w.gcode", gcode + wrong);
+  const CliResult n = run("check " + (dir / "w.gcode").string() + " --mesh " + model);
+  EXPECT_EQ(n.code, 0) << n.err;  // a block that does not read: a notice, and the defaults
+  EXPECT_NE(n.err.find("w.gcode: its settings block is not used: "), std::string::npos) << n.err;
+}
+
 TEST(Cli, HelpAndUsage) {
   const CliResult h = run("analyze --help");
   EXPECT_EQ(h.code, 0);

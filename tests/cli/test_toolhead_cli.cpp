@@ -64,6 +64,10 @@ TEST(CliToolhead, ASaddleSteeperThanTheConeFallsBackWithANotice) {
   const auto s = test::run_cli("slice " + mesh + " -o " + out + " --set nozzle_cone_angle=15");
   ASSERT_EQ(s.code, 0) << s.err;
   EXPECT_NE(s.err.find("printed planar"), std::string::npos) << s.err;
+  // The run ends on a summary line (#16), after the "wrote" line.
+  const std::string last = "0 of 1 curved patch printed curved, the print is planar (patch 0 ";
+  const std::size_t at = s.err.rfind('\n', s.err.size() - 2);
+  EXPECT_EQ(s.err.substr(at + 1, last.size()), last) << s.err;
   const auto j = check_json(out, mesh, " --set nozzle_cone_angle=15");
   ASSERT_FALSE(j.is_null());
   EXPECT_EQ(j["collisions"], 0);
