@@ -8,6 +8,7 @@
 #include "commands.hpp"
 #include "core/file_bytes.hpp"
 #include "nonplanar/check.hpp"
+#include "nonplanar/gcode.hpp"
 
 namespace nonplanar::cli {
 namespace {
@@ -61,6 +62,10 @@ int run(const CheckOptions& o) {
                          o.gcode + ": no extrusion after a ;LAYER_CHANGE comment, so nothing "
                                    "was measured (check reads the G-code of nonplanar, "
                                    "PrusaSlicer and OrcaSlicer)"});
+  // The time with the file's own limits (its settings block, M201-M205), as PrusaSlicer's
+  // viewer estimates it.
+  const double seconds =
+      estimate_print_time(read_gcode_program(bytes->view()), machine_limits(*cfg)).total;
   if (o.json) {
     nlohmann::ordered_json j = {
         {"gcode", o.gcode},
@@ -87,7 +92,8 @@ int run(const CheckOptions& o) {
                                                    f->first_collision.z()}}}},
         {"volume_ratio", f->volume_ratio},
         {"outside_fraction", f->outside_fraction},
-        {"extrusion_points", f->extrusions}};
+        {"extrusion_points", f->extrusions},
+        {"print_time_s", seconds}};
     std::printf("%s\n", j.dump(2).c_str());
     return kExitOk;
   }
@@ -110,6 +116,7 @@ int run(const CheckOptions& o) {
   std::printf("\n");
   std::printf("  extruded / mesh volume  %.3f\n", f->volume_ratio);
   std::printf("  extrusion outside mesh  %.2f %%\n", 100 * f->outside_fraction);
+  std::printf("  print time (estimate)   %s\n", format_duration(seconds).c_str());
   return kExitOk;
 }
 

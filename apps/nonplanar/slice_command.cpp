@@ -139,9 +139,11 @@ int run(const SliceOptions& o) {
                     result->plan.stacks.size() == 1 ? "" : "s");
     std::fprintf(stderr,
                  "wrote %s: %zu layers, %s, layer thickness %.3f-%.3f mm, "
-                 "steepest extrusion %.1f deg, 0 collisions\n",
+                 "steepest extrusion %.1f deg, 0 collisions, %s, %.2f m of filament\n",
                  output->c_str(), result->layers.size(), curved, result->thickness_min,
-                 result->thickness_max, result->steepest_deg);
+                 result->thickness_max, result->steepest_deg,
+                 format_duration(result->stats.seconds).c_str(),
+                 result->stats.filament_mm / 1000.0);
     for (const auto& n : result->notices)  // the last word, after what was written
       if (n.kind == Notice::Kind::summary) std::fprintf(stderr, "%s\n", n.text.c_str());
   }

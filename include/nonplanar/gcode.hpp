@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "nonplanar/config.hpp"
+#include "nonplanar/print_time.hpp"
 #include "nonplanar/program.hpp"
 #include "nonplanar/toolpaths.hpp"
 
@@ -29,6 +30,24 @@ Expected<void> check_custom_gcode(const PrintConfig& c);
 /// lines are written as comments at the top.
 Expected<std::string> make_gcode(const std::vector<LayerToolpaths>& layers, const PrintConfig& c,
                                  const std::vector<std::string>& header, const Context& ctx);
+
+/// The profile's machine limits (machine_max_* keys, their first value; PrusaSlicer's
+/// defaults for the keys it does not set), for estimate_print_time.
+MachineLimits machine_limits(const PrintConfig& c);
+
+/// What with_print_stats measured: s, mm of filament, cm³, g (0 without filament_density).
+struct PrintStats {
+  double seconds = 0, filament_mm = 0, filament_cm3 = 0, filament_g = 0;
+};
+
+/// The program with its statistics recomputed from its own moves, whoever wrote it: the
+/// footer PrusaSlicer writes (filament used in mm, cm³ and g, filament cost when the profile
+/// prices it, "; estimated printing time (normal mode) = 1h 2m 3s"; any such lines already
+/// there are replaced, in place), and with remaining_times = 1 an "M73 P<percent> R<minutes
+/// left>" at every layer change (the old M73 lines dropped). Filament is the net E of every
+/// move; the time is estimate_print_time's with machine_limits(c).
+std::string with_print_stats(std::string_view gcode, const PrintConfig& c,
+                             PrintStats* stats = nullptr);
 
 /// make_gcode into a file, atomically (temporary file, then rename).
 Expected<void> write_gcode_file(const std::filesystem::path& file,

@@ -9,6 +9,7 @@
 #include "nonplanar/check.hpp"
 #include "nonplanar/deform.hpp"
 #include "nonplanar/engine.hpp"
+#include "nonplanar/gcode.hpp"
 #include "nonplanar/layers.hpp"
 
 namespace nonplanar {
@@ -61,6 +62,7 @@ struct SliceResult {
   int shell_layers = 0;    ///< curved layers of a shell over a planar core (0: none)
   int curved_patches = 0;  ///< patches whose surface needs curved layers (0 with planar_only)
   int printed_curved = 0;  ///< of those, the ones printed curved (as stacks or in the shell)
+  PrintStats stats;        ///< time and filament of `gcode` (with_print_stats)
   /// The whole program, as the safety gate checked it: the built-in writer's, or an external
   /// engine's (its start and end G-code and settings kept) mapped back. Write it with
   /// write_gcode_text.

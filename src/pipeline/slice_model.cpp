@@ -9,6 +9,7 @@
 #include "engine/engine_route.hpp"
 #include "layers/banded_field.hpp"
 #include "nonplanar/deform.hpp"
+#include "nonplanar/gcode.hpp"
 #include "nonplanar/pipeline.hpp"
 #include "pipeline/gate.hpp"
 
@@ -290,6 +291,9 @@ Expected<SliceResult> slice_model(const TriangleMesh& mesh, const SliceJob& job,
   if (auto s = summary(*r)) r->notices.push_back(*s);
   if (auto e = nothing_to_print(*r, mesh)) return *e;
   if (auto w = write_program(*r, job, ctx); !w) return w.error();
+  // Time, progress and filament of the file as written, by either engine (an engine's own
+  // were for the flattened part).
+  r->gcode = with_print_stats(r->gcode, job.print, &r->stats);
   r->notices.insert(r->notices.begin(), job.notices.begin(), job.notices.end());
   return r;
 }

@@ -1,0 +1,38 @@
+// How long a G-code program takes to print: Marlin's planner as PrusaSlicer's G-code viewer
+// models it (GCodeProcessor's time estimate), so our numbers and its agree. Units: mm, s,
+// mm/s, mm/s².
+#pragma once
+
+#include <vector>
+
+#include "nonplanar/program.hpp"
+
+namespace nonplanar {
+
+/// The printer's motion limits (PrusaSlicer's machine_max_* keys, their first, "normal"
+/// mode value). Defaults: PrusaSlicer's own. M201, M203, M204 and M205 in the program
+/// change them from where they stand, as they change the printer's.
+struct MachineLimits {
+  double feed_x = 500, feed_y = 500, feed_z = 12, feed_e = 120;           ///< mm/s
+  double accel_x = 9000, accel_y = 9000, accel_z = 500, accel_e = 10000;  ///< mm/s²
+  double accel_extruding = 1500, accel_retracting = 1500, accel_travel = 1250;
+  double jerk_x = 10, jerk_y = 10, jerk_z = 0.2, jerk_e = 2.5;  ///< mm/s
+  double min_extruding_rate = 0, min_travel_rate = 0;           ///< mm/s
+};
+
+struct PrintTime {
+  double total = 0;  ///< s, moves and dwells (G4)
+  /// Seconds elapsed when each line of the program starts: line_start[i] for lines[i], and
+  /// one more entry, the total.
+  std::vector<double> line_start;
+};
+
+/// Every G0/G1 becomes a block with Marlin's trapezoid: entry speeds bounded by the jerk
+/// limits at each junction, then a backward and a forward pass over the whole program so
+/// each block can reach its neighbours' speeds within its acceleration.
+PrintTime estimate_print_time(const GcodeProgram& program, const MachineLimits& limits);
+
+/// "1h 2m 3s", "23m 2s", "45s", as PrusaSlicer writes an estimate.
+std::string format_duration(double seconds);
+
+}  // namespace nonplanar

@@ -1,0 +1,124 @@
+// Statistics after mapping (#16): time, progress and filament recomputed from the file about
+// to be written, so a mapped PrusaSlicer file no longer carries the flattened part's numbers.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "core/text_tokens.hpp"
+#include "nonplanar/gcode.hpp"
+
+namespace nonplanar {
+namespace {
+
+// The first value of a profile key ("1000,960": normal and stealth mode), if it is a number.
+std::optional<double> first_number(const PrintConfig& c, const std::string& key) {
+  const auto it = c.profile.find(key);
+  if (it == c.profile.end()) return std::nullopt;
+  const std::string& v = it->second;
+  const auto d = core::parse_double(std::string_view(v).substr(0, v.find(',')));
+  if (!d || !std::isfinite(*d) || *d < 0) return std::nullopt;
+  return d;
+}
+
+// Lines this pass writes itself: the ones an earlier writer left are dropped.
+bool is_stat_line(std::string_view l) {
+  for (std::string_view p : {"; filament used [", "; total filament used [", "; filament cost =",
+                             "; total filament cost =", "; estimated printing time",
+                             "; estimated first layer printing time"})
+    if (l.substr(0, p.size()) == p) return true;
+  return l.size() >= 4 && (l.substr(0, 4) == "M73 " || l == "M73");
+}
+
+// "M73 P40 R12": percent done and minutes left.
+std::string progress_line(double at, double total) {
+  const int pct = total > 0 ? static_cast<int>(std::floor(100.0 * at / total)) : 100;
+  const long left = std::lround(std::max(0.0, total - at) / 60.0);
+  char buf[48];
+  std::snprintf(buf, sizeof buf, "M73 P%d R%ld\n", std::clamp(pct, 0, 100), left);
+  return buf;
+}
+
+}  // namespace
+
+MachineLimits machine_limits(const PrintConfig& c) {
+  MachineLimits m;
+  const std::pair<const char*, double*> keys[] = {
+      {"machine_max_feedrate_x", &m.feed_x},
+      {"machine_max_feedrate_y", &m.feed_y},
+      {"machine_max_feedrate_z", &m.feed_z},
+      {"machine_max_feedrate_e", &m.feed_e},
+      {"machine_max_acceleration_x", &m.accel_x},
+      {"machine_max_acceleration_y", &m.accel_y},
+      {"machine_max_acceleration_z", &m.accel_z},
+      {"machine_max_acceleration_e", &m.accel_e},
+      {"machine_max_acceleration_extruding", &m.accel_extruding},
+      {"machine_max_acceleration_retracting", &m.accel_retracting},
+      {"machine_max_acceleration_travel", &m.accel_travel},
+      {"machine_max_jerk_x", &m.jerk_x},
+      {"machine_max_jerk_y", &m.jerk_y},
+      {"machine_max_jerk_z", &m.jerk_z},
+      {"machine_max_jerk_e", &m.jerk_e},
+      {"machine_min_extruding_rate", &m.min_extruding_rate},
+      {"machine_min_travel_rate", &m.min_travel_rate}};
+  for (const auto& [key, field] : keys)
+    if (auto v = first_number(c, key)) *field = *v;
+  // PrusaSlicer 2.5 writes a travel acceleration of 0 for "as extruding".
+  if (m.accel_travel <= 0) m.accel_travel = m.accel_extruding;
+  return m;
+}
+
+std::string with_print_stats(std::string_view gcode, const PrintConfig& c, PrintStats* stats) {
+  const GcodeProgram program = read_gcode_program(gcode);
+  const PrintTime t = estimate_print_time(program, machine_limits(c));
+  double filament = 0;  // net: a retraction and its restore cancel
+  for (const GcodeMove& m : program.moves) filament += m.de;
+  filament = std::max(0.0, filament);
+  const double d = c.gcode.filament_diameter;
+  const double cm3 = filament * M_PI * 0.25 * d * d / 1000.0;
+  const double grams = cm3 * first_number(c, "filament_density").value_or(0);
+  const auto cost_per_kg = first_number(c, "filament_cost");
+  const bool progress = first_number(c, "remaining_times").value_or(0) != 0;
+  PrintStats s{t.total, filament, cm3, grams};
+  if (stats) *stats = s;
+
+  char buf[512];
+  std::string block;
+  std::snprintf(buf, sizeof buf,
+                "; filament used [mm] = %.2f\n; filament used [cm3] = %.2f\n"
+                "; filament used [g] = %.2f\n",
+                filament, cm3, grams);
+  block += buf;
+  if (cost_per_kg) {
+    std::snprintf(buf, sizeof buf, "; filament cost = %.2f\n", grams / 1000.0 * *cost_per_kg);
+    block += buf;
+  }
+  block += "; estimated printing time (normal mode) = " + format_duration(t.total) + "\n";
+
+  std::string out;
+  out.reserve(gcode.size() + gcode.size() / 50 + block.size());
+  bool placed = false, finished = false;
+  if (progress) out += progress_line(0, t.total);  // first, as PrusaSlicer writes it
+  auto finish = [&] {  // 100 % once the print is done, before the footer at the latest
+    if (progress && !finished) out += progress_line(1, 1), finished = true;
+  };
+  auto place = [&] {
+    finish();
+    if (!placed) out += block, placed = true;
+  };
+  for (std::size_t i = 0; i < program.lines.size(); ++i) {
+    const std::string_view l = program.lines[i].raw;
+    if (l == "; prusaslicer_config = begin") place();
+    if (is_stat_line(l)) {
+      if (l.rfind("; ", 0) == 0) place();
+      continue;
+    }
+    if (progress && l == ";LAYER_CHANGE") out += progress_line(t.line_start[i], t.total);
+    if (i == program.print_end) finish();
+    out.append(l.data(), l.size());
+    out += '\n';
+  }
+  place();
+  return out;
+}
+
+}  // namespace nonplanar

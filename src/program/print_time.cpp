@@ -1,0 +1,239 @@
+// The time estimate of print_time.hpp: PrusaSlicer's GCodeProcessor planner (itself Marlin's
+// classic-jerk planner), with the whole program as its look-ahead instead of 64 blocks.
+// Notation: v speeds (mm/s), a acceleration (mm/s²), d a block's length (mm); axes X Y Z E.
+#include "nonplanar/print_time.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cctype>
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+#include "core/text_tokens.hpp"
+
+namespace nonplanar {
+namespace {
+
+using Axes = std::array<double, 4>;  // X, Y, Z, E
+
+struct Block {
+  double d = 0, a = 0;
+  double cruise = 0, entry = 0, max_entry = 0, safe = 0;
+  bool nominal_length = false;
+  std::size_t line = 0;  ///< the line it is written on
+  double time(double exit) const;
+};
+
+// Speed reachable from `v` over `d` at deceleration `a` (< 0 accelerates backwards).
+double max_allowable(double a, double v, double d) {
+  return std::sqrt(std::max(0.0, v * v - 2 * a * d));
+}
+
+// Marlin's trapezoid: accelerate from entry to cruise (or as far as the length allows),
+// cruise, decelerate to exit.
+double Block::time(double exit) const {
+  if (d <= 0) return 0;
+  if (a <= 0) return d / std::max(cruise, 1e-6);
+  const double v0 = std::min(entry, cruise), v1 = std::min(exit, cruise);
+  double acc = (cruise * cruise - v0 * v0) / (2 * a);
+  const double dec = (cruise * cruise - v1 * v1) / (2 * a);
+  double top = cruise, flat = d - acc - dec;
+  if (flat < 0) {  // no cruise: the accelerating and decelerating ramps meet
+    acc = std::clamp((2 * a * d - v0 * v0 + v1 * v1) / (4 * a), 0.0, d);
+    top = std::sqrt(std::max(0.0, v0 * v0 + 2 * a * acc));
+    flat = 0;
+  }
+  top = std::max(top, 1e-6);
+  return (top - v0) / a + flat / top + (top - v1) / a;
+}
+
+// The limits as the program changes them: "M203 X200 Y200 Z12 E120" and the like.
+class Limits {
+ public:
+  explicit Limits(const MachineLimits& m)
+      : feed_{m.feed_x, m.feed_y, m.feed_z, m.feed_e},
+        accel_{m.accel_x, m.accel_y, m.accel_z, m.accel_e},
+        jerk_{m.jerk_x, m.jerk_y, m.jerk_z, m.jerk_e},
+        max_print_(m.accel_extruding),
+        max_travel_(m.accel_travel),
+        print_(m.accel_extruding),
+        retract_(m.accel_retracting),
+        travel_(m.accel_travel),
+        min_extruding_(m.min_extruding_rate),
+        min_travel_(m.min_travel_rate) {}
+
+  /// Reads an M201/M203/M204/M205 line; other lines change nothing.
+  void read(std::string_view raw) {
+    core::Tokenizer tok(raw.substr(0, raw.find(';')));
+    const auto cmd = tok.next();
+    if (cmd != "M201" && cmd != "M203" && cmd != "M204" && cmd != "M205") return;
+    for (auto w = tok.next(); !w.empty(); w = tok.next()) {
+      const auto v = core::parse_double(w.substr(1));
+      if (!v || !std::isfinite(*v) || *v < 0) continue;
+      const char k = static_cast<char>(std::toupper(static_cast<unsigned char>(w[0])));
+      const int axis = k == 'X' ? 0 : k == 'Y' ? 1 : k == 'Z' ? 2 : k == 'E' ? 3 : -1;
+      if (cmd == "M201" && axis >= 0) accel_[axis] = *v;
+      if (cmd == "M203" && axis >= 0) feed_[axis] = *v;
+      if (cmd == "M205" && axis >= 0) jerk_[axis] = *v;
+      if (cmd == "M204") {  // capped by the profile's limits, as PrusaSlicer caps them
+        auto cap = [](double x, double max) { return max > 0 ? std::min(x, max) : x; };
+        if (k == 'S' || k == 'P') print_ = cap(*v, max_print_);
+        if (k == 'S' || k == 'T') travel_ = cap(*v, max_travel_);
+        if (k == 'R') retract_ = *v;
+      }
+    }
+  }
+  Axes feed_, accel_, jerk_;
+  double max_print_, max_travel_, print_, retract_, travel_, min_extruding_, min_travel_;
+};
+
+// What the planner remembers of the last block for the next junction.
+struct Previous {
+  double feed = 0, safe = 0;
+  Axes axis{0, 0, 0, 0};  // signed axis speeds
+};
+
+// One G0/G1 as a block with its junction speed (PrusaSlicer's process_G1), or none when it
+// moves nothing.
+bool make_block(const GcodeMove& m, const Limits& L, Previous& prev, bool first, Block& b) {
+  const Vec3 dxyz = m.to - m.from;
+  const Axes delta{dxyz.x(), dxyz.y(), dxyz.z(), m.de};
+  double d = dxyz.norm();
+  const bool e_only = d < 1e-9;
+  if (e_only) d = std::abs(m.de);
+  if (d < 1e-9) return false;
+  const bool extruding = m.de > 0 && !e_only;
+  double v = std::isnan(m.feed) ? 25.0 : m.feed / 60.0;
+  v = std::max(v, extruding ? L.min_extruding_ : L.min_travel_);
+  Axes axis{};
+  for (int k = 0; k < 4; ++k) axis[k] = v * delta[k] / d;
+  double scale = 1;
+  for (int k = 0; k < 4; ++k)
+    if (L.feed_[k] > 0 && std::abs(axis[k]) > L.feed_[k])
+      scale = std::min(scale, L.feed_[k] / std::abs(axis[k]));
+  v *= scale;
+  for (double& s : axis) s *= scale;
+  double a = e_only ? L.retract_ : extruding ? L.print_ : L.travel_;
+  for (int k = 0; k < 4; ++k)
+    if (L.accel_[k] > 0 && std::abs(delta[k]) > 1e-12 && a * std::abs(delta[k]) / d > L.accel_[k])
+      a = L.accel_[k] * d / std::abs(delta[k]);
+  double safe = v;
+  for (int k = 0; k < 4; ++k)
+    if (std::abs(axis[k]) > L.jerk_[k]) safe = std::min(safe, L.jerk_[k]);
+  double junction = safe;
+  if (!first && prev.feed > 1e-4) {
+    const bool prev_faster = prev.feed > v;
+    const double slower = prev_faster ? v / prev.feed : prev.feed / v;
+    junction = prev_faster ? v : prev.feed;
+    double factor = 1;
+    bool limited = false;
+    for (int k = 0; k < 4; ++k) {
+      double v_exit = prev.axis[k], v_entry = axis[k];
+      if (prev_faster) v_exit *= slower;
+      if (limited) v_exit *= factor, v_entry *= factor;
+      // Coasting on, or reversing: the jerk the axis feels at the junction.
+      const double jerk =
+          v_exit > v_entry
+              ? (v_entry > 0 || v_exit < 0 ? v_exit - v_entry : std::max(v_exit, -v_entry))
+              : (v_entry < 0 || v_exit > 0 ? v_entry - v_exit : std::max(-v_exit, v_entry));
+      if (jerk > L.jerk_[k]) factor *= L.jerk_[k] / jerk, limited = true;
+    }
+    if (limited) junction *= factor;
+    const double threshold = junction * 0.99;
+    if (prev.safe > threshold && safe > threshold) junction = safe;
+  }
+  const double allowable = max_allowable(-a, safe, d);
+  b.d = d, b.a = a, b.cruise = v, b.safe = safe;
+  b.entry = std::min(junction, allowable);
+  b.max_entry = junction;
+  b.nominal_length = v <= allowable;
+  prev.feed = v, prev.safe = safe, prev.axis = axis;
+  return true;
+}
+
+// The look-ahead: each block's entry lowered so the one before can slow to it (reverse), and
+// so it can be reached from the one before (forward).
+void plan(std::vector<Block>& blocks) {
+  for (std::size_t i = blocks.size(); i-- > 1;) {
+    Block& b = blocks[i - 1];
+    const Block& next = blocks[i];
+    if (b.entry == b.max_entry) continue;
+    b.entry = !b.nominal_length && b.max_entry > next.entry
+                  ? std::min(b.max_entry, max_allowable(-b.a, next.entry, b.d))
+                  : b.max_entry;
+  }
+  for (std::size_t i = 1; i < blocks.size(); ++i) {
+    const Block& prev = blocks[i - 1];
+    Block& b = blocks[i];
+    if (!prev.nominal_length && prev.entry < b.entry)
+      b.entry = std::min(b.entry, max_allowable(-prev.a, prev.entry, prev.d));
+  }
+}
+
+// G4 P<ms> or S<s>.
+double dwell(std::string_view raw) {
+  core::Tokenizer tok(raw.substr(0, raw.find(';')));
+  const auto cmd = tok.next();
+  if (cmd != "G4" && cmd != "g4") return 0;
+  double t = 0;
+  for (auto w = tok.next(); !w.empty(); w = tok.next()) {
+    const auto v = core::parse_double(w.substr(1));
+    if (!v || !std::isfinite(*v) || *v < 0) continue;
+    if (w[0] == 'P' || w[0] == 'p') t = *v / 1000.0;
+    if (w[0] == 'S' || w[0] == 's') t = *v;
+  }
+  return std::min(t, 86400.0);
+}
+
+}  // namespace
+
+PrintTime estimate_print_time(const GcodeProgram& program, const MachineLimits& limits) {
+  Limits L(limits);
+  Previous prev;
+  std::vector<Block> blocks;
+  std::vector<double> extra(program.lines.size(), 0.0);  // dwells
+  for (std::size_t i = 0; i < program.lines.size(); ++i) {
+    const GcodeLine& l = program.lines[i];
+    if (l.kind == GcodeLine::Kind::move) {
+      Block b;
+      if (make_block(program.moves[static_cast<std::size_t>(l.move)], L, prev, blocks.empty(), b))
+        b.line = i, blocks.push_back(b);
+    } else if (l.kind == GcodeLine::Kind::text && !l.raw.empty()) {
+      L.read(l.raw);
+      extra[i] = dwell(l.raw);
+    }
+  }
+  plan(blocks);
+  std::vector<double> spent(program.lines.size(), 0.0);
+  for (std::size_t k = 0; k < blocks.size(); ++k) {
+    const double exit = k + 1 < blocks.size() ? blocks[k + 1].entry : blocks[k].safe;
+    spent[blocks[k].line] += blocks[k].time(exit);
+  }
+  PrintTime t;
+  t.line_start.resize(program.lines.size() + 1);
+  double at = 0;
+  for (std::size_t i = 0; i < program.lines.size(); ++i) {
+    t.line_start[i] = at;
+    at += spent[i] + extra[i];
+  }
+  t.line_start.back() = t.total = at;
+  return t;
+}
+
+std::string format_duration(double seconds) {
+  const long s = std::lround(std::max(0.0, seconds));
+  const long d = s / 86400, h = s / 3600 % 24, m = s / 60 % 60, sec = s % 60;
+  char buf[64];
+  if (d > 0)
+    std::snprintf(buf, sizeof buf, "%ldd %ldh %ldm %lds", d, h, m, sec);
+  else if (h > 0)
+    std::snprintf(buf, sizeof buf, "%ldh %ldm %lds", h, m, sec);
+  else if (m > 0)
+    std::snprintf(buf, sizeof buf, "%ldm %lds", m, sec);
+  else
+    std::snprintf(buf, sizeof buf, "%lds", sec);
+  return buf;
+}
+
+}  // namespace nonplanar

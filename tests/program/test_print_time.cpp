@@ -1,0 +1,99 @@
+// The time estimate (program/print_time.cpp) on moves whose trapezoids can be worked out by
+// hand, and the stats pass (gcode/print_stats.cpp) that writes it into a file.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+#include "nonplanar/gcode.hpp"
+#include "nonplanar/print_time.hpp"
+
+namespace nonplanar {
+namespace {
+
+double seconds(const std::string& gcode, const MachineLimits& m) {
+  return estimate_print_time(read_gcode_program(gcode), m).total;
+}
+
+MachineLimits no_jerk() {
+  MachineLimits m;
+  m.jerk_x = m.jerk_y = m.jerk_z = m.jerk_e = 0;  // every block starts and ends at rest
+  return m;
+}
+
+TEST(PrintTime, OneMoveIsATrapezoidOrATriangle) {
+  MachineLimits m = no_jerk();
+  m.accel_travel = 1000;
+  // 100 mm at 50 mm/s, 1000 mm/s²: 1.25 mm up, 97.5 mm flat, 1.25 mm down.
+  EXPECT_NEAR(seconds("G1 X100 F3000\n", m), 2 * 0.05 + 97.5 / 50, 1e-9);
+  // 1 mm cannot reach 100 mm/s: the ramps meet at sqrt(a d), t = 2 sqrt(d / a).
+  EXPECT_NEAR(seconds("G1 X1 F6000\n", m), 2 * std::sqrt(1.0 / 1000), 1e-9);
+  // Jerk as large as the speed: no ramps at all.
+  m.jerk_x = m.jerk_y = 100;
+  EXPECT_NEAR(seconds("G1 X100 F3000\n", m), 2.0, 1e-9);
+}
+
+TEST(PrintTime, LimitsFromTheProfileAndTheFile) {
+  MachineLimits m = no_jerk();
+  m.accel_travel = m.accel_extruding = 1000;
+  // M203 caps X at 10 mm/s: 100 mm takes 10 s plus the ramps (2 × 0.01 s − 0.1 mm / 10).
+  EXPECT_NEAR(seconds("M203 X10\nG1 X100 F3000\n", m), 10 + 0.01, 1e-9);
+  // M204 S500 halves the acceleration: ramps of 0.1 s, 2.5 mm each.
+  EXPECT_NEAR(seconds("M204 S500\nG1 X100 F3000\n", m), 0.2 + 95.0 / 50, 1e-9);
+  // A diagonal's acceleration is capped by the axis it loads: M201 X100 on a 45° move.
+  const double a = 100 * std::sqrt(2.0), d = 100 * std::sqrt(2.0), v = 50;
+  EXPECT_NEAR(seconds("M201 X100\nG1 X100 Y100 F3000\n", m), 2 * v / a + (d - v * v / a) / v, 1e-9);
+  // A dwell and a retraction (E only, at the retract acceleration).
+  m.accel_retracting = 1000;
+  EXPECT_NEAR(seconds("G4 P500\nG1 E-1 F2400\n", m), 0.5 + 2 * std::sqrt(1.0 / 1000), 1e-9);
+}
+
+TEST(PrintTime, JunctionsKeepSpeedWhereJerkAllows) {
+  // Two collinear 50 mm moves at the same speed: the junction is not a stop, so the pair
+  // takes exactly what one 100 mm move takes; a 90° corner with no jerk stops in between.
+  MachineLimits m = no_jerk();
+  m.accel_travel = 1000;
+  const double straight = seconds("G1 X50 F3000\nG1 X100\n", m);
+  EXPECT_NEAR(straight, seconds("G1 X100 F3000\n", m), 1e-9);
+  const double corner = seconds("G1 X50 F3000\nG1 X50 Y50\n", m);
+  EXPECT_NEAR(corner, 2 * seconds("G1 X50 F3000\n", m), 1e-9);
+  EXPECT_EQ(format_duration(3723.4), "1h 2m 3s");
+  EXPECT_EQ(format_duration(1382), "23m 2s");
+  EXPECT_EQ(format_duration(45), "45s");
+}
+
+TEST(PrintStats, FooterAndProgressAreRecomputedInPlace) {
+  PrintConfig c;
+  c.profile["remaining_times"] = "1";
+  c.profile["filament_density"] = "1.24";
+  c.profile["machine_max_acceleration_extruding"] = "1000";
+  c.profile["machine_max_jerk_x"] = "0";
+  c.profile["machine_max_jerk_y"] = "0";
+  c.profile["machine_max_jerk_e"] = "0";
+  // An engine's file: stale M73 and footer for the flattened part, then its config block.
+  const std::string in =
+      "M73 P0 R99\nG90\nM83\n;LAYER_CHANGE\n;Z:0.2\nG1 X100 E10 F3000\n;LAYER_CHANGE\n;Z:0.4\n"
+      "M73 P50 R50\nG1 X0 E10\n;TYPE:Custom\nM84\n; filament used [mm] = 999.00\n"
+      "; estimated printing time (normal mode) = 9h 0m 0s\n"
+      "; prusaslicer_config = begin\n; layer_height = 0.2\n; prusaslicer_config = end\n";
+  PrintStats s;
+  const std::string out = with_print_stats(in, c, &s);
+  EXPECT_NEAR(s.seconds, 2 * (2 * 0.05 + 97.5 / 50), 1e-9);  // two 100 mm extrusions
+  EXPECT_NEAR(s.filament_mm, 20, 1e-12);
+  EXPECT_NEAR(s.filament_g, 20 * M_PI * 0.25 * 1.75 * 1.75 / 1000 * 1.24, 1e-12);
+  const std::string want =
+      "M73 P0 R0\nG90\nM83\nM73 P0 R0\n;LAYER_CHANGE\n;Z:0.2\nG1 X100 E10 F3000\n"
+      "M73 P50 R0\n;LAYER_CHANGE\n;Z:0.4\nG1 X0 E10\nM73 P100 R0\n;TYPE:Custom\nM84\n"
+      "; filament used [mm] = 20.00\n; filament used [cm3] = 0.05\n; filament used [g] = 0.06\n"
+      "; estimated printing time (normal mode) = 4s\n"
+      "; prusaslicer_config = begin\n; layer_height = 0.2\n; prusaslicer_config = end\n";
+  EXPECT_EQ(out, want);
+  // Without remaining_times: no M73 at all, the footer still recomputed.
+  c.profile.erase("remaining_times");
+  const std::string plain = with_print_stats(in, c);
+  EXPECT_EQ(plain.find("M73"), std::string::npos);
+  EXPECT_NE(plain.find("; estimated printing time (normal mode) = 4s\n"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace nonplanar
