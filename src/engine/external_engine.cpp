@@ -144,6 +144,31 @@ std::string layer_profile(const std::vector<double>& tops, double h, double top)
 
 }  // namespace
 
+namespace {
+
+// The flavour asked for is the flavour written: PrusaSlicer 2.5 reads gcode_flavor = klipper
+// (2.6's) as its default, reprap, without a word, and the file would say so only in its
+// last lines (#16).
+std::optional<Error> flavor_kept(const PrintConfig& c, const std::string& gcode,
+                                 const std::string& name) {
+  const auto asked = c.profile.find("gcode_flavor");
+  if (asked == c.profile.end()) return std::nullopt;
+  const std::string block = gcode_config_block(gcode);
+  const std::string key = "gcode_flavor = ";
+  const auto at = block.find(key);
+  if (at == std::string::npos || (at > 0 && block[at - 1] != '\n')) return std::nullopt;
+  const std::string wrote = block.substr(at + key.size(), block.find('\n', at) - at - key.size());
+  if (wrote == asked->second) return std::nullopt;
+  return Error{Status::unsupported,
+               "engine: " + name + " wrote gcode_flavor = " + wrote + ", not " + asked->second +
+                   ": this " + name +
+                   " cannot write that flavour (PrusaSlicer writes klipper "
+                   "from 2.6 on); use --gcode-flavor marlin2 (Klipper reads it) or --engine "
+                   "builtin"};
+}
+
+}  // namespace
+
 Expected<std::string> run_engine(const EngineParams& e, const TriangleMesh& mesh,
                                  const PrintConfig& c, const Context& ctx, const EngineRun& run) {
   const bool orca = e.engine == Engine::orcaslicer;
@@ -278,6 +303,7 @@ Expected<std::string> run_engine(const EngineParams& e, const TriangleMesh& mesh
                  "engine: " + name +
                      "'s G-code stops before its end (no statistics or config block after the "
                      "last layer): a truncated file is not printed"};
+  if (auto f = flavor_kept(c, gcode, name)) return *f;
   return gcode;
 }
 

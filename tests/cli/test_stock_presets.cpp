@@ -192,5 +192,30 @@ TEST(StockPresets, CurvedTopsThroughBothRoutes) {
   }
 }
 
+// #16 item 5: the flavour asked for is the flavour written, or the run says it cannot be.
+// PrusaSlicer 2.5 (Debian 12's) reads gcode_flavor = klipper as reprap without a word.
+TEST(StockPresets, AFlavourTheEngineCannotWriteIsRefusedNotChanged) {
+  if (!have_bundles()) GTEST_SKIP() << "prusa-slicer not installed";
+  const fs::path dir = test::temp_dir("engine_flavour");
+  ASSERT_TRUE(write_stl(dir / "saddle.stl", test::saddle()));
+  const fs::path out = dir / "k.gcode";
+  const auto r = test::run_cli("slice -q " + (dir / "saddle.stl").string() +
+                               " --engine prusaslicer --gcode-flavor klipper -o " + out.string());
+  if (r.code == 0) {  // a PrusaSlicer that knows Klipper
+    EXPECT_NE(test::read_bytes(out).find("\n; gcode_flavor = klipper\n"), std::string::npos);
+  } else {
+    EXPECT_EQ(r.code, 2);
+    EXPECT_NE(r.err.find("wrote gcode_flavor = reprap, not klipper: this PrusaSlicer cannot "
+                         "write that flavour"),
+              std::string::npos)
+        << r.err;
+    EXPECT_FALSE(fs::exists(out));
+  }
+  const auto m = test::run_cli("slice -q " + (dir / "saddle.stl").string() +
+                               " --engine prusaslicer --gcode-flavor marlin2 -o " + out.string());
+  ASSERT_EQ(m.code, 0) << m.err;
+  EXPECT_NE(test::read_bytes(out).find("\n; gcode_flavor = marlin2\n"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace nonplanar
