@@ -162,7 +162,7 @@ Expected<void> PresetOptions::apply(PrintConfig& c,
 void ProfileOptions::add_to(CLI::App& cmd, const std::string& what) {
   presets.add_to(cmd);
   cmd.add_option("--load,--config", config,
-                 "Profile: .json or PrusaSlicer .ini (" + what +
+                 "Profile: PrusaSlicer .ini or OrcaSlicer/flat .json (" + what +
                      "); repeat it for a printer, a print and a filament file, each over the "
                      "ones before");
   cmd.add_option("--set", sets,

@@ -168,8 +168,9 @@ void register_slice(CLI::App& app, std::function<int()>* run_fn) {
       ->required();
   o->presets.add_to(*cmd);
   cmd->add_option("--load,--config", o->config,
-                  "Profile: .json or PrusaSlicer .ini; repeat it for a printer, a print and a\n"
-                  "filament file (PrusaSlicer exports them one by one), each over the ones before");
+                  "Profile: PrusaSlicer .ini, OrcaSlicer machine/process/filament .json (its\n"
+                  "inherits resolved; docs/orcaslicer-profiles.md) or a flat .json; repeat it for\n"
+                  "a printer, a print and a filament file, each over the ones before");
   cmd->add_flag("--planar", o->planar, "Planar layers only (the ordinary slicing engine)");
   cmd->add_option("--engine", o->engine,
                   "Planar engine for the normalised mesh: builtin, prusaslicer (PrusaSlicer 2.5+\n"

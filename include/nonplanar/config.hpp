@@ -140,6 +140,19 @@ Expected<PrintConfig> load_config(const std::filesystem::path& file, PrintConfig
 /// when the file has none (our built-in engine's, OrcaSlicer's).
 std::string gcode_config_block(std::string_view gcode);
 
+/// OrcaSlicer's profiles (docs/orcaslicer-profiles.md). Is this JSON one (a "type" of
+/// machine, process or filament, or an "inherits")?
+bool is_orca_profile(std::string_view json_text);
+/// PrusaSlicer's name for an OrcaSlicer key (wall_loops → perimeters); other keys unchanged.
+std::string prusaslicer_key(const std::string& orca_key);
+/// The profile in `file` with its `inherits` chain resolved (parents looked for beside it and
+/// in its vendor's machine, process and filament folders, by file name or "name"), as
+/// PrusaSlicer keys and values: arrays of numbers joined with commas, of text their first
+/// item; widths in % (of the nozzle, in OrcaSlicer) in mm. Keys we do not use are kept, for
+/// the macros and another engine. Errors name the file.
+Expected<std::vector<std::pair<std::string, std::string>>> orca_profile_keys(
+    const std::filesystem::path& file);
+
 /// Parses .ini text / JSON text over `base` (for tests and fuzzing).
 Expected<PrintConfig> parse_ini_config(std::string_view text, PrintConfig base = {});
 Expected<PrintConfig> parse_json_config(std::string_view text, PrintConfig base = {});

@@ -24,7 +24,7 @@ Expected<PrintConfig> parse_json_config(std::string_view text, PrintConfig c) {
       value = v.dump();
     } else
       return Error{Status::parse_error, key + ": expected a number, string or boolean"};
-    auto r = set_config_value(c, key, value);
+    auto r = set_config_value(c, prusaslicer_key(key), value);
     if (!r) return r.error();
   }
   if (auto v = validate_config(c); !v) return v.error();
@@ -37,6 +37,16 @@ Expected<PrintConfig> load_config(const std::filesystem::path& file, PrintConfig
   std::string ext = file.extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(),
                  [](unsigned char ch) { return std::tolower(ch); });
+  if (ext == ".json" && is_orca_profile(bytes->view())) {
+    auto keys = orca_profile_keys(file);
+    if (!keys) return keys.error();
+    for (const auto& [key, value] : *keys)
+      if (auto r = set_config_value(base, key, value); !r)
+        return Error{r.error().status, file.string() + ": " + r.error().message};
+    if (auto v = validate_config(base); !v)
+      return Error{v.error().status, file.string() + ": " + v.error().message};
+    return base;
+  }
   Expected<PrintConfig> r =
       ext == ".json" ? parse_json_config(bytes->view(), std::move(base))
       : ext == ".ini"
