@@ -64,6 +64,9 @@ printf '<?xml version="1.0" encoding="UTF-8"?>\n<Types xmlns="http://schemas.ope
 printf '<?xml version="1.0" encoding="UTF-8"?>\n<Relationships xmlns="http://schemas.openxmlformats.org/package/2006/relationships"><Relationship Target="/3D/3dmodel.model" Id="rel0" Type="http://schemas.microsoft.com/3dmanufacturing/2013/01/3dmodel"/></Relationships>' >"$tmf/_rels/.rels"
 printf '<?xml version="1.0" encoding="UTF-8"?>\n<model unit="millimeter" xmlns="http://schemas.microsoft.com/3dmanufacturing/core/2015/02"><resources><object id="1" type="model"><mesh><vertices><vertex x="0" y="0" z="0"/><vertex x="10" y="0" z="0"/><vertex x="0" y="10" z="0"/><vertex x="0" y="0" z="10"/></vertices><triangles><triangle v1="0" v2="2" v3="1"/><triangle v1="0" v2="1" v3="3"/><triangle v1="1" v2="2" v3="3"/><triangle v1="0" v2="3" v3="2"/></triangles></mesh></object></resources><build><item objectid="1" transform="1 0 0 0 1 0 0 0 1 5 5 0"/></build></model>' >"$tmf/3D/3dmodel.model"
 (cd "$tmf" && zip -q -X -r "$OLDPWD/$out/corpus/3mf/tetra.3mf" '[Content_Types].xml' _rels 3D)
+# The same with a relationship to a thumbnail it lacks (PrusaSlicer's --export-3mf): the repair.
+printf '<?xml version="1.0" encoding="UTF-8"?>\n<Relationships xmlns="http://schemas.openxmlformats.org/package/2006/relationships"><Relationship Target="/3D/3dmodel.model" Id="rel0" Type="http://schemas.microsoft.com/3dmanufacturing/2013/01/3dmodel"/><Relationship Target="/Metadata/thumbnail.png" Id="rel1" Type="http://schemas.openxmlformats.org/package/2006/relationships/metadata/thumbnail"/></Relationships>' >"$tmf/_rels/.rels"
+(cd "$tmf" && zip -q -X -r "$OLDPWD/$out/corpus/3mf/tetra_thumb.3mf" '[Content_Types].xml' _rels 3D)
 rm -rf "$tmf"
 
 mkdir -p "$out/findings"

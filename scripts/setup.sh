@@ -16,7 +16,7 @@ pkgs=(
   libeigen3-dev libceres-dev libtbb-dev libpolyclipping-dev lib3mf-dev
   libcli11-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  zip unzip time
+  zlib1g-dev zip unzip time
 )
 for arg in "$@"; do
   case "$arg" in

@@ -10,6 +10,7 @@
 
 #include "core/atomic_file.hpp"
 #include "io/readers.hpp"
+#include "io/zip_package.hpp"
 
 namespace nonplanar::io {
 namespace {
@@ -170,10 +171,7 @@ bool append_object(NMR::PLib3MFModelObjectResource* obj, const Affine& xf, Trian
   return true;
 }
 
-}  // namespace
-
-Expected<TriangleMesh> parse_3mf(std::string_view data, std::size_t max_triangles) {
-  if (data.empty()) return Error{Status::parse_error, "file is empty"};
+Expected<TriangleMesh> parse_package(std::string_view data, std::size_t max_triangles) {
   Handle model, reader;
   if (NMR::lib3mf_createmodel(&model.p) != 0 ||
       NMR::lib3mf_model_queryreader(model.p, "3mf", &reader.p) != 0)
@@ -237,6 +235,19 @@ Expected<TriangleMesh> parse_3mf(std::string_view data, std::size_t max_triangle
     for (Vec3& v : mesh.vertices) v *= mm;
   if (mesh.faces.empty()) return Error{Status::invalid_mesh, "3MF build holds no triangles"};
   return mesh;
+}
+
+}  // namespace
+
+Expected<TriangleMesh> parse_3mf(std::string_view data, std::size_t max_triangles) {
+  if (data.empty()) return Error{Status::parse_error, "file is empty"};
+  auto r = parse_package(data, max_triangles);
+  if (r || r.error().message.rfind("not a valid 3MF file", 0) != 0) return r;
+  // A package lib3mf refuses for a part it names but lacks (PrusaSlicer's command line names
+  // a thumbnail it never wrote): read again without such relationships.
+  if (auto fixed = drop_dangling_relationships(data, nullptr))
+    if (auto again = parse_package(*fixed, max_triangles)) return again;
+  return r;
 }
 
 }  // namespace nonplanar::io

@@ -1,0 +1,19 @@
+// The OPC package (zip) around a 3MF model, repaired where lib3mf refuses it: PrusaSlicer's
+// command line writes a relationship to /Metadata/thumbnail.png without the picture, and
+// lib3mf then fails with "Could not create OPC Part".
+#pragma once
+
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace nonplanar::io {
+
+/// The package with every relationship whose target is not in it removed, rebuilt as a zip
+/// of stored entries; nullopt when nothing was removed or the zip cannot be read (ZIP64,
+/// encryption, an entry over 1 GB, a bad deflate stream). `dropped` gets the targets removed.
+std::optional<std::string> drop_dangling_relationships(std::string_view zip,
+                                                       std::vector<std::string>* dropped);
+
+}  // namespace nonplanar::io

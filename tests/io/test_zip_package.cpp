@@ -1,0 +1,102 @@
+// The 3MF package repair (io/zip_package.hpp): PrusaSlicer's `--export-3mf` names a thumbnail
+// it does not write, and lib3mf refused the file ("Could not create OPC Part", #16).
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+
+#include "io/readers.hpp"
+#include "io/zip_package.hpp"
+#include "nonplanar/io.hpp"
+#include "support/files.hpp"
+#include "support/solids.hpp"
+
+namespace nonplanar {
+namespace {
+
+namespace fs = std::filesystem;
+
+// A one-tetrahedron 3MF zipped by `zip` (deflated entries), its root relationships as given.
+std::string tetra_3mf(const std::string& name, const std::string& rels) {
+  const fs::path d = test::temp_dir(name);
+  fs::create_directories(d / "_rels");
+  fs::create_directories(d / "3D");
+  test::write_bytes(d / "[Content_Types].xml",
+                    "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<Types xmlns=\"http://schemas."
+                    "openxmlformats.org/package/2006/content-types\"><Default Extension=\"rels\" "
+                    "ContentType=\"application/vnd.openxmlformats-package.relationships+xml\"/>"
+                    "<Default Extension=\"model\" ContentType=\"application/vnd.ms-package."
+                    "3dmanufacturing-3dmodel+xml\"/><Default Extension=\"png\" "
+                    "ContentType=\"image/png\"/></Types>");
+  test::write_bytes(d / "_rels" / ".rels", rels);
+  test::write_bytes(
+      d / "3D" / "3dmodel.model",
+      "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<model unit=\"millimeter\" xmlns=\"http://"
+      "schemas.microsoft.com/3dmanufacturing/core/2015/02\"><resources><object id=\"1\" "
+      "type=\"model\"><mesh><vertices><vertex x=\"0\" y=\"0\" z=\"0\"/><vertex x=\"10\" y=\"0\" "
+      "z=\"0\"/><vertex x=\"0\" y=\"10\" z=\"0\"/><vertex x=\"0\" y=\"0\" z=\"10\"/></vertices>"
+      "<triangles><triangle v1=\"0\" v2=\"2\" v3=\"1\"/><triangle v1=\"0\" v2=\"1\" v3=\"3\"/>"
+      "<triangle v1=\"1\" v2=\"2\" v3=\"3\"/><triangle v1=\"0\" v2=\"3\" v3=\"2\"/></triangles>"
+      "</mesh></object></resources><build><item objectid=\"1\"/></build></model>");
+  const std::string cmd =
+      "cd '" + d.string() + "' && zip -q -X -r p.3mf '[Content_Types].xml' _rels 3D";
+  EXPECT_EQ(std::system(cmd.c_str()), 0);
+  return test::read_bytes(d / "p.3mf");
+}
+
+const char* kModelRel =
+    "<Relationship Target=\"/3D/3dmodel.model\" Id=\"rel-1\" Type=\"http://schemas.microsoft."
+    "com/3dmanufacturing/2013/01/3dmodel\"/>";
+const char* kThumbRel =
+    "<Relationship Target=\"/Metadata/thumbnail.png\" Id=\"rel-2\" Type=\"http://schemas."
+    "openxmlformats.org/package/2006/relationships/metadata/thumbnail\"/>";
+
+std::string rels(const std::string& inner) {
+  return "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<Relationships xmlns=\"http://schemas."
+         "openxmlformats.org/package/2006/relationships\">" +
+         inner + "</Relationships>";
+}
+
+TEST(ZipPackage, AThumbnailNamedButMissingIsDroppedAndTheModelLoads) {
+  const std::string good = tetra_3mf("zip_good", rels(kModelRel));
+  EXPECT_FALSE(io::drop_dangling_relationships(good, nullptr));  // nothing to drop
+  const std::string bad = tetra_3mf("zip_thumb", rels(std::string(kModelRel) + kThumbRel));
+  std::vector<std::string> dropped;
+  const auto fixed = io::drop_dangling_relationships(bad, &dropped);
+  ASSERT_TRUE(fixed);
+  EXPECT_EQ(dropped, std::vector<std::string>{"/Metadata/thumbnail.png"});
+  // The rebuilt package holds the same model: 4 faces, 10 mm tall.
+  auto m = io::parse_3mf(*fixed);
+  ASSERT_TRUE(m) << m.error().message;
+  EXPECT_EQ(m->faces.size(), 4u);
+  auto direct = io::parse_3mf(bad);  // parse_3mf repairs by itself
+  ASSERT_TRUE(direct) << direct.error().message;
+  EXPECT_EQ(direct->faces.size(), 4u);
+  EXPECT_FALSE(io::drop_dangling_relationships("PK\x05\x06 not really a zip", nullptr));
+  // Found by fuzz_3mf: a local header offset of 0xffffffff wrapped a 32-bit "offset + 30"
+  // past the bounds check and read outside the buffer.
+  std::string hostile = bad;
+  const std::size_t cd = hostile.find("PK\x01\x02");
+  ASSERT_NE(cd, std::string::npos);
+  hostile.replace(cd + 42, 4, "\xff\xff\xff\xff");
+  EXPECT_FALSE(io::drop_dangling_relationships(hostile, nullptr));
+}
+
+TEST(ZipPackage, PrusaSlicersOwnExportLoads) {
+  if (std::system("command -v prusa-slicer >/dev/null 2>&1") != 0)
+    GTEST_SKIP() << "prusa-slicer not installed";
+  const fs::path d = test::temp_dir("zip_prusa");
+  ASSERT_TRUE(write_stl(d / "box.stl", test::box({0, 0, 0}, {20, 10, 5})));
+  const std::string cmd = "prusa-slicer --export-3mf -o '" + (d / "box.3mf").string() + "' '" +
+                          (d / "box.stl").string() + "' >/dev/null 2>&1";
+  ASSERT_EQ(std::system(cmd.c_str()), 0);
+  auto m = load_mesh(d / "box.3mf", {}, {});
+  ASSERT_TRUE(m) << m.error().message;
+  const BoundingBox b = bounding_box(m->mesh);
+  EXPECT_NEAR(b.size().x(), 20, 1e-4);
+  EXPECT_NEAR(b.size().y(), 10, 1e-4);
+  EXPECT_NEAR(b.size().z(), 5, 1e-4);
+}
+
+}  // namespace
+}  // namespace nonplanar
