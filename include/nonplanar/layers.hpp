@@ -58,6 +58,10 @@ struct LayerStack {
   double cost_before = 0, cost_after = 0;
   int iterations = 0;
   std::string optimizer_message;
+  /// When no plane let every layer clear the nozzle tip's reach uphill within
+  /// max_layer_height: about the max_layer_height that would (mm; 0: none was needed, or
+  /// none would do). The stack is built anyway and the final check judges it.
+  double tip_needs_max_layer_height = 0;
 };
 
 /// A patch that keeps planar layers, and why.

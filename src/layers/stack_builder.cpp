@@ -258,17 +258,29 @@ StackResult build_stack(const TriangleMesh& mesh, const Patch& patch, int patch_
         return false;
     return true;
   };
-  double k_pick = k;
+  // The most layers over plane c that clear the tip everywhere (0: none), without h_max.
+  const auto most_clear = [&](double c) {
+    double n_max = 1e9;
+    for (int kk = 0; kk < n; ++kk) {
+      const double need = (p.toolhead.tip_radius + 0.1) * top_tan[kk] - 0.5 * p.layer_height;
+      if (grid.on_patch[kk] && need > 0) n_max = std::min(n_max, (top_z[kk] - c) / need);
+    }
+    return static_cast<int>(std::min(n_max, 500.0));
+  };
+  double k_pick = k, hint = 1e300;
   int N = count_for(p.first_layer_height + k * p.layer_height, false);
   for (double kk = k; kk >= 0 && kk > k - 200; --kk) {
     const double c = p.first_layer_height + kk * p.layer_height;
     const int a = count_for(c, false), b = count_for(c, true);
     const int clear = tip_clear(c, a) ? a : tip_clear(c, b) ? b : 0;
     if (clear > 0) {
-      k_pick = kk, N = clear;
+      k_pick = kk, N = clear, hint = 1e300;
       break;
     }
+    // What h_max would let this plane's clear stack be (count_for keeps 3 % margin).
+    if (const int m = most_clear(c); m >= 1) hint = std::min(hint, (zmax - c) / m / 0.97);
   }
+  if (hint < 1e299) st.tip_needs_max_layer_height = std::ceil(hint * 100 - 1e-6) / 100;
   st.c = p.first_layer_height + k_pick * p.layer_height;
   st.T_bottom = planar.T(st.c);
   const double D_min = zmin - st.c, D_max = zmax - st.c;

@@ -202,6 +202,26 @@ Expected<std::optional<SliceResult>> try_shell(const TriangleMesh& mesh, const S
 
 namespace {
 
+// When a stack's layers were too thin for the nozzle tip on its slopes: the limit and the
+// value that would have let it clear (#16: the MK3S's 0.15 mm SPEED preset on the saddle).
+std::string tip_hint(const SliceResult& r, int patch, const SliceJob& job) {
+  for (const LayerStack& st : r.plan.stacks) {
+    if (st.patch != patch || st.tip_needs_max_layer_height <= 0) continue;
+    const double need = st.tip_needs_max_layer_height;
+    char buf[240];
+    if (need > job.print.paths.nozzle_diameter)
+      std::snprintf(buf, sizeof buf,
+                    "; its slopes need layers thicker than the nozzle allows (%.2f mm)", need);
+    else
+      std::snprintf(buf, sizeof buf,
+                    "; its slopes need thicker layers than max_layer_height = %.2f mm allows: "
+                    "--max-layer-height %.2f would let the nozzle tip clear them",
+                    job.layers.max_layer_height, need);
+    return buf;
+  }
+  return "";
+}
+
 // slice_model's rounds: attempts, retries without the patches that broke a limit, shells.
 Expected<SliceResult> slice_rounds(const TriangleMesh& mesh, const SliceJob& job,
                                    const Context& ctx) {
@@ -257,7 +277,8 @@ Expected<SliceResult> slice_rounds(const TriangleMesh& mesh, const SliceJob& job
     }
     for (const auto& [patch, why] : offenders) {
       excluded.push_back(patch);
-      dropped.push_back(planar_notice(patch, "in its final paths " + why));
+      dropped.push_back(
+          planar_notice(patch, "in its final paths " + why + tip_hint(*r, patch, job)));
     }
   }
   return Error{Status::internal_error, "safety check: still failing after dropping 8 patches"};
@@ -267,13 +288,16 @@ Expected<SliceResult> slice_rounds(const TriangleMesh& mesh, const SliceJob& job
 // reason given (the notices before it say the rest).
 std::optional<Notice> summary(const SliceResult& r) {
   if (r.curved_patches == 0 || r.printed_curved >= r.curved_patches) return std::nullopt;
-  std::string why;  // the shell's refusal (the last thing tried), else a patch's own reason
+  std::string why;  // a limit to change first, else the shell's refusal (the last thing
+                    // tried), else a patch's own reason
+  for (const Notice& n : r.notices)
+    if (why.empty() && n.text.find(" would let ") != n.text.npos) why = n.text;
   for (const Notice& n : r.notices)
     if (why.empty() && n.kind == Notice::Kind::shell && n.text.find(" not printed") != n.text.npos)
       why = n.text;
   for (const Notice& n : r.notices)
     if (why.empty() && n.kind == Notice::Kind::patch_planar) why = n.text;
-  if (why.size() > 160) why = why.substr(0, 157) + "...";
+  if (why.size() > 320) why = why.substr(0, 317) + "...";
   std::string text = std::to_string(r.printed_curved) + " of " + std::to_string(r.curved_patches) +
                      (r.curved_patches == 1 ? " curved patch" : " curved patches") +
                      " printed curved";

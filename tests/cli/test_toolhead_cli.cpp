@@ -74,6 +74,38 @@ TEST(CliToolhead, ASaddleSteeperThanTheConeFallsBackWithANotice) {
   EXPECT_LE(j["steepest_extrusion"].get<double>(), 15.5);
 }
 
+// #16: the MK3S's 0.15 mm SPEED limits (layers 0.15, 0.07-0.25 mm) are too thin for the
+// saddle's 27° flanks under a 0.4 mm tip. The patch prints planar, and the notice names the
+// limit and the value that would clear it; that value does.
+TEST(CliToolhead, TooThinALayerLimitIsNamedWithTheValueThatWorks) {
+  const auto dir = test::temp_dir("cli_toolhead_hint");
+  ASSERT_TRUE(write_stl(dir / "saddle.stl", test::saddle()));
+  const std::string mesh = (dir / "saddle.stl").string(), out = (dir / "s.gcode").string();
+  const std::string limits = " --layer-height 0.15 --min-layer-height 0.07";
+  const auto s =
+      test::run_cli("slice " + mesh + " -o " + out + limits + " --max-layer-height 0.25");
+  ASSERT_EQ(s.code, 0) << s.err;
+  const std::string hint =
+      "its slopes need thicker layers than max_layer_height = 0.25 mm "
+      "allows: --max-layer-height ";
+  const std::size_t at = s.err.find(hint);
+  ASSERT_NE(at, std::string::npos) << s.err;
+  const double value = std::stod(s.err.substr(at + hint.size(), 4));
+  EXPECT_GT(value, 0.25);
+  EXPECT_LE(value, 0.30);
+  EXPECT_NE(s.err.find("0 of 1 curved patch printed curved"), std::string::npos) << s.err;
+  char v[16];
+  std::snprintf(v, sizeof v, "%.2f", value);
+  const auto t =
+      test::run_cli("slice " + mesh + " -o " + out + limits + " --max-layer-height " + v);
+  ASSERT_EQ(t.code, 0) << t.err;
+  EXPECT_NE(t.err.find(", 1 curved stack,"), std::string::npos) << t.err;
+  const auto j = check_json(out, mesh, "");
+  ASSERT_FALSE(j.is_null());
+  EXPECT_EQ(j["collisions"], 0);
+  EXPECT_LE(j["top_surface_deviation"]["p95"].get<double>(), 0.02);
+}
+
 TEST(CliToolhead, AHeadFileIsUsedAndBadHeadSettingsAreRefused) {
   const auto dir = test::temp_dir("cli_toolhead_file");
   ASSERT_TRUE(write_stl(dir / "roof.stl", test::sine_roof()));
