@@ -114,6 +114,7 @@ int run(const SliceOptions& o) {
                   box.size().x(), box.size().y(), bed.x(), bed.y());
     return finish_progress(), report_error({Status::invalid_argument, o.mesh.model + buf});
   }
+  cfg.gcode.object_name = std::filesystem::path(o.mesh.model).filename().string();
   SliceJob job = make_job(cfg, o.max_angle);
   job.planar_only = o.planar;
   job.engine = engine;

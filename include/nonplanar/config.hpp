@@ -67,6 +67,8 @@ struct GcodeParams {
   /// before_layer_gcode and layer_gcode), and around the print for the first extruder's
   /// filament. Every block is a template of PrusaSlicer's macro language (macros.hpp).
   std::string before_layer_gcode, layer_gcode, start_filament_gcode, end_filament_gcode;
+  /// The object's name in its labels (gcode_label_objects): the model's file name.
+  std::string object_name = "part";
 };
 
 /// Settings PrusaSlicer states relative to others, as written: "150%" (widths: of the layer

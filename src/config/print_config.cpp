@@ -194,6 +194,12 @@ Expected<bool> set_value(PrintConfig& c, const std::string& key, const std::stri
       return bad(key, "'" + v + "' is not marlin2, klipper or reprapfirmware");
     return true;
   }
+  if (key == "gcode_label_objects") {  // 2.5's 0/1, 2.6's names; object_labels.hpp reads it
+    const std::string v = first_item(value);
+    if (v != "0" && v != "1" && v != "disabled" && v != "octoprint" && v != "firmware")
+      return bad(key, "'" + v + "' is not 0, 1, disabled, octoprint or firmware");
+    return true;
+  }
   if (key == "start_gcode") {
     r.start_gcode_given = true;
     return g.start_gcode = unescape(value), true;

@@ -12,6 +12,8 @@
 
 #include "core/atomic_file.hpp"
 #include "nonplanar/gcode.hpp"
+
+#include "gcode/object_labels.hpp"
 #include "nonplanar/macros.hpp"
 #include "program/gcode_text.hpp"
 
@@ -411,6 +413,16 @@ Expected<std::string> make_gcode(const std::vector<LayerToolpaths>& layers, cons
   em.line("G21 ; millimetres");
   em.line("G90 ; absolute XYZ");
   em.line(g.relative_e ? "M83 ; relative E" : "M82 ; absolute E");
+  const gcode::ObjectLabels labels = gcode::object_labels(c);
+  if (labels.firmware) {  // the object's footprint, for Klipper's DEFINE
+    Vec2 lo(1e300, 1e300), hi(-1e300, -1e300);
+    for (const LayerToolpaths& L : layers)
+      for (const ExtrusionPath& p : L.paths)
+        if (p.role != ExtrusionRole::skirt)
+          for (const Vec3& q : p.points)
+            lo = lo.cwiseMin(q.head<2>()), hi = hi.cwiseMax(q.head<2>());
+    if (lo.x() <= hi.x()) em.raw(labels.define(lo, hi));
+  }
   em.raw(start);
   em.raw(blocks->start_filament);
   em.line("G92 E0");
@@ -438,8 +450,10 @@ Expected<std::string> make_gcode(const std::vector<LayerToolpaths>& layers, cons
     ExtrusionRole role = ExtrusionRole::skirt;
     double width = -1;
     bool first = true;
+    bool labelled = false;  // inside this layer's object label
     for (const ExtrusionPath& p : L.paths) {
       if (p.points.size() < 2) continue;
+      if (!labelled && p.role != ExtrusionRole::skirt) em.raw(labels.start()), labelled = true;
       em.what = p.role == ExtrusionRole::skirt ? "the skirt" : "the print";
       em.travel(p.points.front(), c.paths.travel_speed, L.nonplanar, L.max_z, L.max_slope);
       if (first || p.role != role) em.line(";TYPE:%s", role_name(p.role));
@@ -456,6 +470,7 @@ Expected<std::string> make_gcode(const std::vector<LayerToolpaths>& layers, cons
         em.extrude(p.points[k], de, p.speed);
       }
     }
+    if (labelled) em.raw(labels.stop());
     em.retract();
     ctx.progress("gcode", static_cast<double>(i + 1) / static_cast<double>(layers.size()));
   }

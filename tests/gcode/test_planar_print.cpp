@@ -262,6 +262,46 @@ TEST(PlanarPrint, CustomGcodeIsCheckedNotPassedRaw) {
   EXPECT_NE(base.text.find("G1 Y200 E15 F1200 ; purge line"), std::string::npos);
 }
 
+// #16 item 7: cancel-object labels around each layer's part (not the skirt), as PrusaSlicer
+// writes them: OctoPrint's comments, and the firmware's M486 or Klipper's EXCLUDE_OBJECT_*.
+TEST(PlanarPrint, ObjectLabelsWrapEveryLayerOfThePart) {
+  auto count = [](const std::string& text, const std::string& what) {
+    std::size_t n = 0;
+    for (std::size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1))
+      ++n;
+    return n;
+  };
+  PrintConfig c;
+  c.gcode.object_name = "box part.stl";
+  ASSERT_TRUE(set_config_value(c, "gcode_label_objects", "1"));
+  const Printed m = print(test::box({0, 0, 0}, {20, 10, 2}), c);
+  const std::size_t layers = count(m.text, ";LAYER_CHANGE\n");
+  ASSERT_EQ(layers, 10u);
+  EXPECT_EQ(count(m.text, "\nM486 T1\n"), 1u);
+  EXPECT_EQ(count(m.text, "\nM486 S0\n"), layers);
+  EXPECT_EQ(count(m.text, "\nM486 S-1\n"), layers);
+  EXPECT_EQ(count(m.text, "; printing object box part.stl id:0 copy 0\n"), layers);
+  // The skirt is outside the label: the first layer's label opens after its skirt.
+  const std::size_t skirt = m.text.find(";TYPE:Skirt/Brim"), open = m.text.find("M486 S0");
+  EXPECT_LT(skirt, open);
+  ASSERT_TRUE(set_config_value(c, "gcode_flavor", "klipper"));
+  const Printed k = print(test::box({0, 0, 0}, {20, 10, 2}), c);
+  EXPECT_EQ(count(k.text, "EXCLUDE_OBJECT_START NAME=box_part.stl_id_0_copy_0\n"), layers);
+  EXPECT_EQ(count(k.text, "EXCLUDE_OBJECT_END NAME=box_part.stl_id_0_copy_0\n"), layers);
+  EXPECT_EQ(count(k.text, "M486"), 0u);
+  // The footprint: the 20 x 10 box at the bed's centre, its outer perimeter's centre line
+  // half a width inside.
+  const std::string def =
+      "EXCLUDE_OBJECT_DEFINE NAME=box_part.stl_id_0_copy_0 CENTER=110.000,110.000 "
+      "POLYGON=[[100.";
+  EXPECT_NE(k.text.find(def), std::string::npos) << k.text.substr(0, 2000);
+  ASSERT_TRUE(set_config_value(c, "gcode_label_objects", "octoprint"));
+  const Printed o = print(test::box({0, 0, 0}, {20, 10, 2}), c);
+  EXPECT_EQ(count(o.text, "EXCLUDE_OBJECT"), 0u);
+  EXPECT_EQ(count(o.text, "; stop printing object box part.stl id:0 copy 0\n"), layers);
+  EXPECT_FALSE(set_config_value(c, "gcode_label_objects", "sometimes"));
+}
+
 TEST(Config, BadValuesNameTheKeyAndLine) {
   auto r = parse_ini_config("layer_height = 0.2\nfill_density = lots\n");
   ASSERT_FALSE(r);

@@ -100,8 +100,9 @@ inline Program read_gcode(const std::string& text) {
       prog.moves.push_back(m);
       pos = to;
     } else if (cmd == "G4" || cmd == "G21" || cmd == "G28" || cmd == "M84" || cmd == "M104" ||
-               cmd == "M106" || cmd == "M107" || cmd == "M109" || cmd == "M140" || cmd == "M190") {
-      // known, no motion
+               cmd == "M106" || cmd == "M107" || cmd == "M109" || cmd == "M140" || cmd == "M190" ||
+               cmd == "M486" || cmd.rfind("EXCLUDE_OBJECT_", 0) == 0) {
+      // known, no motion (M486 and EXCLUDE_OBJECT_*: object labels)
     } else if (prog.error.empty()) {
       prog.error = "unknown command " + cmd + " at line " + std::to_string(n);
     }
