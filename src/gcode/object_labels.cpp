@@ -9,7 +9,7 @@ ObjectLabels object_labels(const PrintConfig& c) {
   const auto it = c.profile.find("gcode_label_objects");
   const std::string v = it == c.profile.end() ? "" : it->second;
   l.comments = v == "1" || v == "firmware" || v == "octoprint";
-  l.firmware = v == "1" || v == "firmware";
+  l.firmware = v == "firmware";  // 2.6's; 2.5's "1" wrote the comments only, as here
   l.klipper = c.gcode.flavor == GcodeFlavor::klipper;
   l.name = c.gcode.object_name.empty() ? "part" : c.gcode.object_name;
   return l;

@@ -20,8 +20,9 @@ struct ObjectLabels {
   std::string stop() const;   ///< after them
 };
 
-/// From gcode_label_objects: 1 or firmware (both kinds), octoprint (comments only), 0 or
-/// disabled or absent (none); the object named GcodeParams::object_name.
+/// From gcode_label_objects as each PrusaSlicer writes it: firmware (2.6: both kinds), 1
+/// (2.5) or octoprint (comments only), 0 or disabled or absent (none); the object named
+/// GcodeParams::object_name.
 ObjectLabels object_labels(const PrintConfig& c);
 
 }  // namespace nonplanar::gcode
