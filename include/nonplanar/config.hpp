@@ -138,8 +138,9 @@ Expected<void> validate_config(const PrintConfig& c);
 Expected<PrintConfig> load_config(const std::filesystem::path& file, PrintConfig base = {});
 
 /// The settings block PrusaSlicer writes at the end of its G-code ("; prusaslicer_config =
-/// begin" … "= end", one "; key = value" per line) as .ini text for parse_ini_config; empty
-/// when the file has none (our built-in engine's, OrcaSlicer's).
+/// begin" … "= end", one "; key = value" per line), or OrcaSlicer's ("; CONFIG_BLOCK_START"
+/// … "_END", its keys renamed by prusaslicer_key), as .ini text for parse_ini_config; empty
+/// when the file has none (our built-in engine's).
 std::string gcode_config_block(std::string_view gcode);
 
 /// OrcaSlicer's profiles (docs/orcaslicer-profiles.md). Is this JSON one (a "type" of

@@ -4,12 +4,17 @@
 namespace nonplanar {
 
 std::string gcode_config_block(std::string_view gcode) {
-  constexpr std::string_view kBegin = "; prusaslicer_config = begin";
-  constexpr std::string_view kEnd = "; prusaslicer_config = end";
+  // PrusaSlicer's block, else OrcaSlicer's (its keys renamed to PrusaSlicer's).
+  bool orca = false;
+  std::string_view begin = "; prusaslicer_config = begin", end = "; prusaslicer_config = end";
   // It is the file's last part: search from the end, so a long file costs nothing more.
-  const std::size_t b = gcode.rfind(kBegin);
+  std::size_t b = gcode.rfind(begin);
+  if (b == std::string_view::npos) {
+    begin = "; CONFIG_BLOCK_START", end = "; CONFIG_BLOCK_END", orca = true;
+    b = gcode.rfind(begin);
+  }
   if (b == std::string_view::npos || (b > 0 && gcode[b - 1] != '\n')) return {};
-  const std::size_t e = gcode.find(kEnd, b);
+  const std::size_t e = gcode.find(end, b);
   if (e == std::string_view::npos) return {};
   std::string ini;
   for (std::size_t p = gcode.find('\n', b); p != std::string_view::npos && p < e;) {
@@ -17,7 +22,11 @@ std::string gcode_config_block(std::string_view gcode) {
     std::string_view line = gcode.substr(p + 1, q - p - 1);
     if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
     if (line.rfind("; ", 0) == 0) {
-      ini.append(line.substr(2));
+      line.remove_prefix(2);
+      const std::size_t eq = line.find(" = ");
+      if (orca && eq != std::string_view::npos)
+        ini += prusaslicer_key(std::string(line.substr(0, eq))), line.remove_prefix(eq);
+      ini.append(line);
       ini += '\n';
     }
     p = q < e ? q : std::string_view::npos;

@@ -224,6 +224,9 @@ TEST(Cli, CheckReadsTheBedFromTheFilesSettingsBlock) {
   EXPECT_GT(outside(gcode, ""), 0.3);                // placed at (110, 110): 15 mm off
   EXPECT_LT(outside(gcode + block, ""), 0.01);       // the block's bed: centred at (125, 105)
   EXPECT_LT(outside(gcode, " --set " + bed), 0.01);  // or the user's
+  const std::string orca =                           // OrcaSlicer's block and key name
+      "; CONFIG_BLOCK_START\n; printable_area = 0x0,250x0,250x210,0x210\n; CONFIG_BLOCK_END\n";
+  EXPECT_LT(outside(gcode + orca, ""), 0.01);
   const std::string wrong =
       "; prusaslicer_config = begin\n; bed_shape = 0x0,1x0\n"
       "; prusaslicer_config = end\n";
