@@ -414,15 +414,7 @@ Expected<std::string> make_gcode(const std::vector<LayerToolpaths>& layers, cons
   em.line("G90 ; absolute XYZ");
   em.line(g.relative_e ? "M83 ; relative E" : "M82 ; absolute E");
   const gcode::ObjectLabels labels = gcode::object_labels(c);
-  if (labels.firmware) {  // the object's footprint, for Klipper's DEFINE
-    Vec2 lo(1e300, 1e300), hi(-1e300, -1e300);
-    for (const LayerToolpaths& L : layers)
-      for (const ExtrusionPath& p : L.paths)
-        if (p.role != ExtrusionRole::skirt)
-          for (const Vec3& q : p.points)
-            lo = lo.cwiseMin(q.head<2>()), hi = hi.cwiseMax(q.head<2>());
-    if (lo.x() <= hi.x()) em.raw(labels.define(lo, hi));
-  }
+  em.raw(labels.define(layers));
   em.raw(start);
   em.raw(blocks->start_filament);
   em.line("G92 E0");

@@ -28,8 +28,15 @@ std::string klipper_id(const std::string& name) {
 }
 }  // namespace
 
-std::string ObjectLabels::define(const Vec2& min, const Vec2& max) const {
+std::string ObjectLabels::define(const std::vector<LayerToolpaths>& layers) const {
   if (!firmware) return "";
+  Vec2 min(1e300, 1e300), max(-1e300, -1e300);
+  for (const LayerToolpaths& L : layers)
+    for (const ExtrusionPath& p : L.paths)
+      if (p.role != ExtrusionRole::skirt)
+        for (const Vec3& q : p.points)
+          min = min.cwiseMin(q.head<2>()), max = max.cwiseMax(q.head<2>());
+  if (min.x() > max.x()) return "";
   char buf[400];
   if (klipper)
     std::snprintf(buf, sizeof buf,

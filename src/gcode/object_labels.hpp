@@ -3,8 +3,10 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "nonplanar/config.hpp"
+#include "nonplanar/toolpaths.hpp"
 
 namespace nonplanar::gcode {
 
@@ -14,8 +16,9 @@ struct ObjectLabels {
   bool klipper = false;
   std::string name;  ///< as the comments carry it; `id` is the firmware's form of it
 
-  /// Before the print: Klipper's EXCLUDE_OBJECT_DEFINE with the footprint (mm), M486 T1.
-  std::string define(const Vec2& min, const Vec2& max) const;
+  /// Before the print: Klipper's EXCLUDE_OBJECT_DEFINE with the footprint of the layers'
+  /// paths but the skirt (their XY box, mm), or M486 T1.
+  std::string define(const std::vector<LayerToolpaths>& layers) const;
   std::string start() const;  ///< before the object's paths of a layer
   std::string stop() const;   ///< after them
 };
