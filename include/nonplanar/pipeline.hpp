@@ -17,16 +17,18 @@ namespace nonplanar {
 /// One line the pipeline has for the user, about one patch or the whole part.
 struct Notice {
   enum class Kind {
-    setting,       ///< a setting was adapted to the printer (make_job)
-    patch_planar,  ///< the patch prints planar, and why
-    none_needed,   ///< no surface needs curved layers: the part slices planar
-    none_fit,      ///< no patch could get a stack (a shell may still print it)
-    shell,         ///< about a shell: printed, or refused and why
-    summary,       ///< the last word: how many curved patches printed curved, when not all
+    setting,        ///< a setting was adapted to the printer (make_job)
+    patch_planar,   ///< the patch prints planar, and why
+    none_needed,    ///< no surface needs curved layers: the part slices planar
+    none_fit,       ///< no patch could get a stack (a shell may still print it)
+    shell,          ///< a shell was printed
+    shell_refused,  ///< a shell was tried and refused, and why
+    summary,        ///< the last word: how many curved patches printed curved, when not all
   };
   Kind kind = Kind::setting;
-  int patch = -1;    ///< the patch it is about (-1: the part, or several patches)
-  std::string text;  ///< the line as printed, e.g. "patch 3 printed planar: ..."
+  int patch = -1;            ///< the patch it is about (-1: the part, or several patches)
+  std::string text;          ///< the line as printed, e.g. "patch 3 printed planar: ..."
+  bool names_a_fix = false;  ///< it names a setting and a value that would print it curved
 };
 
 struct SliceJob {

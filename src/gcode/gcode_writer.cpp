@@ -11,9 +11,8 @@
 #include <string_view>
 
 #include "core/atomic_file.hpp"
-#include "nonplanar/gcode.hpp"
-
 #include "gcode/object_labels.hpp"
+#include "nonplanar/gcode.hpp"
 #include "nonplanar/macros.hpp"
 #include "program/gcode_text.hpp"
 

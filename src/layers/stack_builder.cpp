@@ -250,23 +250,18 @@ StackResult build_stack(const TriangleMesh& mesh, const Patch& patch, int patch_
   // With the even stack a layer is (S_0 − c)/N thick and no steeper than the top, so take
   // the highest plane c, and there the most layers, that keep every patch sample clear; when
   // none does, keep the first choice for the gate to judge.
-  const auto tip_clear = [&](double c, int N) {
-    if (N < 1) return false;
-    for (int kk = 0; kk < n; ++kk)
-      if (grid.on_patch[kk] &&
-          (top_z[kk] - c) / N < (p.toolhead.tip_radius + 0.1) * top_tan[kk] - 0.5 * p.layer_height)
-        return false;
-    return true;
+  // The thinnest layer the tip clears at sample kk.
+  const auto need = [&](int kk) {
+    return (p.toolhead.tip_radius + 0.1) * top_tan[kk] - 0.5 * p.layer_height;
   };
   // The most layers over plane c that clear the tip everywhere (0: none), without h_max.
   const auto most_clear = [&](double c) {
     double n_max = 1e9;
-    for (int kk = 0; kk < n; ++kk) {
-      const double need = (p.toolhead.tip_radius + 0.1) * top_tan[kk] - 0.5 * p.layer_height;
-      if (grid.on_patch[kk] && need > 0) n_max = std::min(n_max, (top_z[kk] - c) / need);
-    }
-    return static_cast<int>(std::min(n_max, 500.0));
+    for (int kk = 0; kk < n; ++kk)
+      if (grid.on_patch[kk] && need(kk) > 0) n_max = std::min(n_max, (top_z[kk] - c) / need(kk));
+    return static_cast<int>(std::max(n_max, -1.0));
   };
+  const auto tip_clear = [&](double c, int N) { return N >= 1 && N <= most_clear(c); };
   double k_pick = k, hint = 1e300;
   int N = count_for(p.first_layer_height + k * p.layer_height, false);
   for (double kk = k; kk >= 0 && kk > k - 200; --kk) {

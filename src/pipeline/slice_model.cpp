@@ -145,7 +145,7 @@ Expected<std::optional<SliceResult>> try_shell(const TriangleMesh& mesh, const S
   for (std::size_t k = 0; k < plan.patches.size(); ++k)
     name += (k ? ", " : " ") + std::to_string(plan.patches[k]);
   auto refused = [&](const std::string& why) {
-    return Notice{Notice::Kind::shell, -1, name + " not printed as a shell: " + why};
+    return Notice{Notice::Kind::shell_refused, -1, name + " not printed as a shell: " + why};
   };
   if (!plan.refused.empty()) {
     if (plan.refused != layers::kNotOnTop) planar.notices.push_back(refused(plan.refused));
@@ -202,14 +202,18 @@ Expected<std::optional<SliceResult>> try_shell(const TriangleMesh& mesh, const S
 
 namespace {
 
-// When a stack's layers were too thin for the nozzle tip on its slopes: the limit and the
-// value that would have let it clear (#16: the MK3S's 0.15 mm SPEED preset on the saddle).
-std::string tip_hint(const SliceResult& r, int patch, const SliceJob& job) {
+// A patch the final paths dropped, planar, with what its stack knew: when its layers were
+// too thin for the nozzle tip on its slopes, the limit and the value that would have let it
+// clear (#16: the MK3S's 0.15 mm SPEED preset on the saddle).
+Notice dropped_notice(const SliceResult& r, int patch, const std::string& why,
+                      const SliceJob& job) {
+  Notice n = planar_notice(patch, "in its final paths " + why);
   for (const LayerStack& st : r.plan.stacks) {
     if (st.patch != patch || st.tip_needs_max_layer_height <= 0) continue;
     const double need = st.tip_needs_max_layer_height;
     char buf[240];
-    if (need > job.print.paths.nozzle_diameter)
+    n.names_a_fix = need <= job.print.paths.nozzle_diameter;
+    if (!n.names_a_fix)
       std::snprintf(buf, sizeof buf,
                     "; its slopes need layers thicker than the nozzle allows (%.2f mm)", need);
     else
@@ -217,9 +221,10 @@ std::string tip_hint(const SliceResult& r, int patch, const SliceJob& job) {
                     "; its slopes need thicker layers than max_layer_height = %.2f mm allows: "
                     "--max-layer-height %.2f would let the nozzle tip clear them",
                     job.layers.max_layer_height, need);
-    return buf;
+    n.text += buf;
+    break;
   }
-  return "";
+  return n;
 }
 
 // slice_model's rounds: attempts, retries without the patches that broke a limit, shells.
@@ -277,8 +282,7 @@ Expected<SliceResult> slice_rounds(const TriangleMesh& mesh, const SliceJob& job
     }
     for (const auto& [patch, why] : offenders) {
       excluded.push_back(patch);
-      dropped.push_back(
-          planar_notice(patch, "in its final paths " + why + tip_hint(*r, patch, job)));
+      dropped.push_back(dropped_notice(*r, patch, why, job));
     }
   }
   return Error{Status::internal_error, "safety check: still failing after dropping 8 patches"};
@@ -290,13 +294,10 @@ std::optional<Notice> summary(const SliceResult& r) {
   if (r.curved_patches == 0 || r.printed_curved >= r.curved_patches) return std::nullopt;
   std::string why;  // a limit to change first, else the shell's refusal (the last thing
                     // tried), else a patch's own reason
-  for (const Notice& n : r.notices)
-    if (why.empty() && n.text.find(" would let ") != n.text.npos) why = n.text;
-  for (const Notice& n : r.notices)
-    if (why.empty() && n.kind == Notice::Kind::shell && n.text.find(" not printed") != n.text.npos)
-      why = n.text;
-  for (const Notice& n : r.notices)
-    if (why.empty() && n.kind == Notice::Kind::patch_planar) why = n.text;
+  for (const bool fix : {true, false})
+    for (const Notice::Kind kind : {Notice::Kind::shell_refused, Notice::Kind::patch_planar})
+      for (const Notice& n : r.notices)
+        if (why.empty() && n.kind == kind && n.names_a_fix == fix) why = n.text;
   if (why.size() > 320) why = why.substr(0, 317) + "...";
   std::string text = std::to_string(r.printed_curved) + " of " + std::to_string(r.curved_patches) +
                      (r.curved_patches == 1 ? " curved patch" : " curved patches") +

@@ -449,20 +449,6 @@ TEST(HostileInput, SeveralProfilesLoadInOrder) {
 // after a grace of 10 s instead of being ignored until it is done (hostile input #21.9).
 TEST(HostileInput, StopsWhileALibraryCannotBeCancelled) {
   const fs::path dir = test::temp_dir("hostile_3mf_nest");
-  const fs::path pkg = dir / "pkg";
-  fs::create_directories(pkg / "_rels");
-  fs::create_directories(pkg / "3D");
-  test::write_bytes(pkg / "[Content_Types].xml",
-                    "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<Types xmlns=\"http://"
-                    "schemas.openxmlformats.org/package/2006/content-types\"><Default "
-                    "Extension=\"rels\" ContentType=\"application/vnd.openxmlformats-package."
-                    "relationships+xml\"/><Default Extension=\"model\" ContentType=\"application/"
-                    "vnd.ms-package.3dmanufacturing-3dmodel+xml\"/></Types>");
-  test::write_bytes(pkg / "_rels" / ".rels",
-                    "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<Relationships xmlns=\"http://"
-                    "schemas.openxmlformats.org/package/2006/relationships\"><Relationship "
-                    "Target=\"/3D/3dmodel.model\" Id=\"rel0\" Type=\"http://schemas.microsoft."
-                    "com/3dmanufacturing/2013/01/3dmodel\"/></Relationships>");
   std::string model =
       "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<model unit=\"millimeter\" xmlns=\"http://"
       "schemas.microsoft.com/3dmanufacturing/core/2015/02\"><resources><object id=\"1\" "
@@ -479,12 +465,8 @@ TEST(HostileInput, StopsWhileALibraryCannotBeCancelled) {
     model += "</components></object>";
   }
   model += "</resources><build><item objectid=\"10\"/></build></model>";
-  test::write_bytes(pkg / "3D" / "3dmodel.model", model);
   const fs::path file = dir / "nested.3mf";
-  ASSERT_EQ(std::system(("cd " + pkg.string() + " && zip -q -X -r " + file.string() +
-                         " '[Content_Types].xml' _rels 3D")
-                            .c_str()),
-            0);
+  ASSERT_TRUE(test::zip_3mf(dir, "nested.3mf", test::kModelRelationship, model));
   for (const bool by_limit : {false, true}) {
     std::vector<std::string> args = {"analyze", file.string()};
     if (by_limit) args.insert(args.end(), {"--max-time", "0.5"});

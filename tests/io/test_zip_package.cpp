@@ -16,51 +16,30 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// A one-tetrahedron 3MF zipped by `zip` (deflated entries), its root relationships as given.
-std::string tetra_3mf(const std::string& name, const std::string& rels) {
+const char* kTetra =
+    "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<model unit=\"millimeter\" xmlns=\"http://"
+    "schemas.microsoft.com/3dmanufacturing/core/2015/02\"><resources><object id=\"1\" "
+    "type=\"model\"><mesh><vertices><vertex x=\"0\" y=\"0\" z=\"0\"/><vertex x=\"10\" y=\"0\" "
+    "z=\"0\"/><vertex x=\"0\" y=\"10\" z=\"0\"/><vertex x=\"0\" y=\"0\" z=\"10\"/></vertices>"
+    "<triangles><triangle v1=\"0\" v2=\"2\" v3=\"1\"/><triangle v1=\"0\" v2=\"1\" v3=\"3\"/>"
+    "<triangle v1=\"1\" v2=\"2\" v3=\"3\"/><triangle v1=\"0\" v2=\"3\" v3=\"2\"/></triangles>"
+    "</mesh></object></resources><build><item objectid=\"1\"/></build></model>";
+
+// A one-tetrahedron 3MF with the given root relationships, as bytes.
+std::string tetra_3mf(const std::string& name, const std::string& relationships) {
   const fs::path d = test::temp_dir(name);
-  fs::create_directories(d / "_rels");
-  fs::create_directories(d / "3D");
-  test::write_bytes(d / "[Content_Types].xml",
-                    "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<Types xmlns=\"http://schemas."
-                    "openxmlformats.org/package/2006/content-types\"><Default Extension=\"rels\" "
-                    "ContentType=\"application/vnd.openxmlformats-package.relationships+xml\"/>"
-                    "<Default Extension=\"model\" ContentType=\"application/vnd.ms-package."
-                    "3dmanufacturing-3dmodel+xml\"/><Default Extension=\"png\" "
-                    "ContentType=\"image/png\"/></Types>");
-  test::write_bytes(d / "_rels" / ".rels", rels);
-  test::write_bytes(
-      d / "3D" / "3dmodel.model",
-      "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<model unit=\"millimeter\" xmlns=\"http://"
-      "schemas.microsoft.com/3dmanufacturing/core/2015/02\"><resources><object id=\"1\" "
-      "type=\"model\"><mesh><vertices><vertex x=\"0\" y=\"0\" z=\"0\"/><vertex x=\"10\" y=\"0\" "
-      "z=\"0\"/><vertex x=\"0\" y=\"10\" z=\"0\"/><vertex x=\"0\" y=\"0\" z=\"10\"/></vertices>"
-      "<triangles><triangle v1=\"0\" v2=\"2\" v3=\"1\"/><triangle v1=\"0\" v2=\"1\" v3=\"3\"/>"
-      "<triangle v1=\"1\" v2=\"2\" v3=\"3\"/><triangle v1=\"0\" v2=\"3\" v3=\"2\"/></triangles>"
-      "</mesh></object></resources><build><item objectid=\"1\"/></build></model>");
-  const std::string cmd =
-      "cd '" + d.string() + "' && zip -q -X -r p.3mf '[Content_Types].xml' _rels 3D";
-  EXPECT_EQ(std::system(cmd.c_str()), 0);
+  EXPECT_TRUE(test::zip_3mf(d, "p.3mf", relationships, kTetra));
   return test::read_bytes(d / "p.3mf");
 }
 
-const char* kModelRel =
-    "<Relationship Target=\"/3D/3dmodel.model\" Id=\"rel-1\" Type=\"http://schemas.microsoft."
-    "com/3dmanufacturing/2013/01/3dmodel\"/>";
 const char* kThumbRel =
     "<Relationship Target=\"/Metadata/thumbnail.png\" Id=\"rel-2\" Type=\"http://schemas."
     "openxmlformats.org/package/2006/relationships/metadata/thumbnail\"/>";
 
-std::string rels(const std::string& inner) {
-  return "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<Relationships xmlns=\"http://schemas."
-         "openxmlformats.org/package/2006/relationships\">" +
-         inner + "</Relationships>";
-}
-
 TEST(ZipPackage, AThumbnailNamedButMissingIsDroppedAndTheModelLoads) {
-  const std::string good = tetra_3mf("zip_good", rels(kModelRel));
+  const std::string good = tetra_3mf("zip_good", test::kModelRelationship);
   EXPECT_FALSE(io::drop_dangling_relationships(good, nullptr));  // nothing to drop
-  const std::string bad = tetra_3mf("zip_thumb", rels(std::string(kModelRel) + kThumbRel));
+  const std::string bad = tetra_3mf("zip_thumb", std::string(test::kModelRelationship) + kThumbRel);
   std::vector<std::string> dropped;
   const auto fixed = io::drop_dangling_relationships(bad, &dropped);
   ASSERT_TRUE(fixed);
