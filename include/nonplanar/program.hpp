@@ -30,8 +30,12 @@ struct GcodeMove {
   bool wipe = false;       ///< between ;WIPE_START and ;WIPE_END
   std::string_view type;   ///< the ;TYPE: in force ("" before any); views the text read
   double width = 0.45;     ///< the ;WIDTH: in force, mm
-  double height = 0.2;     ///< the layer's ;HEIGHT: (the planar thickness), mm
-  int layer = -1;          ///< ;LAYER_CHANGE count − 1
+  /// The planar thickness under it: the latest ;HEIGHT: in force (PrusaSlicer gives a layer
+  /// that follows a support-only layer its distance from that, and the part's beads in it
+  /// their own); a bridge's or overhang's ;HEIGHT: is not taken (it is the round bead's, the
+  /// nozzle's diameter), mm.
+  double height = 0.2;
+  int layer = -1;  ///< ;LAYER_CHANGE count − 1
   /// Pushes filament while moving in XY.
   bool extruding() const { return de > 0 && has_xy && (to - from).head<2>().norm() > 1e-9; }
 };

@@ -11,6 +11,14 @@
 namespace nonplanar {
 namespace {
 
+// A bridge's or an overhang's ;HEIGHT: is its round bead's (the nozzle's diameter), not the
+// thickness over anything under it: such moves keep the thickness in force before them.
+bool bridged(std::string_view type) {
+  for (std::string_view w : {"Bridge", "bridge", "Overhang", "overhang"})
+    if (type.find(w) != std::string_view::npos) return true;
+  return false;
+}
+
 using Kind = GcodeLine::Kind;
 
 char upper(char c) {
@@ -88,6 +96,7 @@ class Reader {
   Vec3 pos_{0, 0, 0};
   GcodeState s_;
   double width_ = 0.45, h_ = 0.2;
+  double bead_h_ = 0.2;  // the latest ;HEIGHT: in force (a support layer's, the part's after it)
   bool wipe_ = false, layer_header_ = false;  // layer_header: ;LAYER_CHANGE seen, not ;HEIGHT:
   std::string_view type_;
   int layer_ = -1;
@@ -160,8 +169,11 @@ void Reader::comment(std::string_view c, std::size_t semi, GcodeLine& item, bool
   // is the nozzle's diameter) and pass untouched.
   if (layer_header_ && semi == 0 && c.rfind(";HEIGHT:", 0) == 0) {
     if (auto v = core::parse_double(c.substr(8)); v && *v > 0) h_ = *v, p_.layer_height.back() = h_;
+    bead_h_ = h_;
     item.kind = Kind::height_comment;
     layer_header_ = false;
+  } else if (semi == 0 && c.rfind(";HEIGHT:", 0) == 0 && !bridged(type_)) {
+    if (auto v = core::parse_double(c.substr(8)); v && *v > 0) bead_h_ = *v;
   }
   if (semi == 0 && c.rfind(";Z:", 0) == 0) {
     item.kind = Kind::z_comment;
@@ -274,7 +286,8 @@ void Reader::move(core::Tokenizer& tok, GcodeLine& item, bool in_print) {
     if (m.de < 0 && r.length == 0) r.length = -m.de, r.f = m.f;
     if (m.de > 0 && std::isnan(r.back_f)) r.back_f = m.f;
   }
-  m.wipe = wipe_, m.type = type_, m.width = width_, m.height = h_, m.layer = layer_;
+  m.wipe = wipe_, m.type = type_, m.width = width_, m.layer = layer_;
+  m.height = bead_h_;
   item.kind = Kind::move;
   if (sink_) return (*sink_)(m);
   item.move = static_cast<int>(p_.moves.size());

@@ -142,6 +142,25 @@ TEST(ReadProgram, RelativeAxesAndResets) {
   EXPECT_TRUE(p.at_end.relative_e);
 }
 
+// PrusaSlicer puts supports on layers of their own between the part's: the part's layer after
+// one has the distance from it in its header, and its beads their own ;HEIGHT:. A bridge's
+// ;HEIGHT: is its round bead's (the nozzle), not a thickness.
+TEST(ReadProgram, EachBeadKeepsItsOwnThickness) {
+  const std::string g =
+      "G1 Z0.4\n;LAYER_CHANGE\n;Z:0.496\n;HEIGHT:0.096\n;TYPE:Support material\n;HEIGHT:0.296\n"
+      "G1 X1 Y1 E1\n;LAYER_CHANGE\n;Z:0.6\n;HEIGHT:0.104\n;TYPE:Perimeter\n;HEIGHT:0.2\n"
+      "G1 Z0.6\nG1 X2 Y1 E2\n;TYPE:Bridge infill\n;HEIGHT:0.4\nG1 X3 Y1 E3\n";
+  const GcodeProgram p = read_gcode_program(g);
+  ASSERT_TRUE(p.problems.empty());
+  ASSERT_EQ(p.layer_height.size(), 2u);
+  EXPECT_DOUBLE_EQ(p.layer_height[0], 0.096);  // the headers'
+  EXPECT_DOUBLE_EQ(p.layer_height[1], 0.104);
+  std::vector<double> h;
+  for (const GcodeMove& m : p.moves)
+    if (m.extruding()) h.push_back(m.height);
+  EXPECT_EQ(h, (std::vector<double>{0.296, 0.2, 0.2}));
+}
+
 TEST(GcodeText, WritesTheWordsAskedForAndKeepsE) {
   program::GcodeText abs(false, 1.0);
   program::MoveWords w;
