@@ -9,7 +9,9 @@
 #include "nonplanar/check.hpp"
 #include "nonplanar/config.hpp"
 #include "nonplanar/deform.hpp"
+#include "nonplanar/field_io.hpp"
 #include "nonplanar/macros.hpp"
+#include "nonplanar/print_plan.hpp"
 #include "nonplanar/surface_io.hpp"
 #include "nonplanar/toolhead.hpp"
 
@@ -166,8 +168,25 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     return v;
   }();
   (void)expand_macros(in, vars, "start_gcode");
+#elif NONPLANAR_FUZZ_PARSER == 12
+  // A plan from a 3MF (post-process reads it from any file): refused, or a field that answers
+  // everywhere over and around its part.
+  auto plan = parse_plan_json(in);
+  if (!plan) return 0;
+  auto field = parse_layer_field_json(plan->field, {1.5, -2.5});
+  if (!field) return 0;
+  const BoundingBox& b = plan->box;
+  for (int i = 0; i <= 4; ++i)
+    for (int k = 0; k <= 4; ++k) {
+      const double x = b.min.x() - 5 + (b.size().x() + 10) * i / 4,
+                   y = b.min.y() - 5 + (b.size().y() + 10) * k / 4;
+      const double t = (*field)->T(x, y, 0.5 * (b.min.z() + b.max.z()));
+      if (std::isfinite(t)) (void)(*field)->z_at(x, y, t);
+      (void)(*field)->thickness(x, y, b.max.z());
+      (void)(*field)->planar_along({x, y}, {y, x}, 0, 5);
+    }
 #else
-#error "NONPLANAR_FUZZ_PARSER must name a parser (0-11)"
+#error "NONPLANAR_FUZZ_PARSER must name a parser (0-12)"
 #endif
   return 0;
 }

@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
 # Run the libFuzzer targets (one per parser; AddressSanitizer + UndefinedBehaviorSanitizer).
 # Usage: fuzz/run.sh [SECONDS=60] [TARGET...]
-#   TARGET: stl obj off 3mf ini json surfaces gcode foreign toolhead settings macros (default: all
+#   TARGET: stl obj off 3mf ini json surfaces gcode foreign toolhead settings macros plan (default: all
 #   of them, two at a time; foreign is the mapping of another slicer's G-code,
 #   map_foreign_gcode; toolhead is a head shape file, docs/toolhead.md; settings prints a box
-#   with any profile that validates and checks the G-code stays on the bed and in range).
+#   with any profile that validates and checks the G-code stays on the bed and in range; plan is
+#   the print plan a prepared 3MF carries, docs/plan-format.md).
 # Builds the missing targets in build-san/ with scripts/sanitize.sh --build-only.
 # Seeds come from ../shared/models, tests/data and toolheads/; corpora grow in build-san/corpus/TARGET,
 # so longer runs pick up where the last one stopped. Findings are written to
@@ -15,7 +16,7 @@ cd "$(dirname "$0")/.."
 secs=${1:-60}
 shift || true
 targets=("$@")
-((${#targets[@]})) || targets=(stl obj off 3mf ini json surfaces gcode foreign toolhead settings macros)
+((${#targets[@]})) || targets=(stl obj off 3mf ini json surfaces gcode foreign toolhead settings macros plan)
 out=${BUILD_DIR:-build-san}
 missing=0
 for t in "${targets[@]}"; do [[ -x "$out/fuzz/fuzz_$t" ]] || missing=1; done
@@ -38,6 +39,7 @@ seed off "$models"/*.off
 seed ini tests/data/*.ini
 seed settings tests/data/*.ini
 seed toolhead toolheads/*.json
+seed plan tests/data/plan_small.json
 mkdir -p "$out/corpus/macros"
 printf '%s' 'M862.3 P "[printer_model]"\n{if max_layer_z < 200}G1 Z{z_offset+min(max_layer_z+30, 200)}{else}G1 Z{max_layer_z+1}{endif}\nM104 S[temperature[0]] ; {digits(1.5,2,1)} {printer_notes=~/.*MK3.*/ ? 1 : 0}\n{elsif}' \
   >"$out/corpus/macros/mk3s.gcode"

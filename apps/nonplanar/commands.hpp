@@ -16,5 +16,9 @@ void register_layers(CLI::App& app, std::function<int()>* run);
 void register_slice(CLI::App& app, std::function<int()>* run);
 /// Adds "check".
 void register_check(CLI::App& app, std::function<int()>* run);
+/// Adds "prepare".
+void register_prepare(CLI::App& app, std::function<int()>* run);
+/// Adds "post-process".
+void register_post_process(CLI::App& app, std::function<int()>* run);
 
 }  // namespace nonplanar::cli

@@ -24,6 +24,8 @@ int main(int argc, char** argv) {
   register_layers(app, &run);
   register_slice(app, &run);
   register_check(app, &run);
+  register_prepare(app, &run);
+  register_post_process(app, &run);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -5,6 +5,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "nonplanar/context.hpp"
 #include "nonplanar/layers.hpp"
@@ -79,6 +80,10 @@ struct ForeignMapOptions {
   /// Filament already pulled back when the print starts (mm): given back with the first
   /// retraction move or before the first extrusion.
   double start_retracted = 0;
+  /// Moves left where the file has them, by 0-based line of the file (1: keep): another
+  /// object on the plate than the one the field was planned for. Travels to them are still
+  /// lifted over curved layers. Empty: every move is mapped.
+  std::vector<char> planar_lines;
 };
 
 /// Maps a planar G-code file (PrusaSlicer's or OrcaSlicer's, or ours) sliced from the

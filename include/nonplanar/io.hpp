@@ -53,10 +53,23 @@ struct PackageFile {
   std::string path, content;
 };
 
+/// The one object of a 3MF as PrusaSlicer and OrcaSlicer read it.
+struct Object3mf {
+  std::string name;  ///< the object's name (empty: none)
+  /// Per-object settings (PrusaSlicer's Metadata/Slic3r_PE_model.config, which OrcaSlicer
+  /// reads too), e.g. {"layer_height", "0.2"}: they go with the object, whatever preset the
+  /// user picks.
+  std::vector<std::pair<std::string, std::string>> settings;
+};
+
 /// 3MF writer: one mesh object, one build item with no transform, and `extra` files (e.g.
 /// PrusaSlicer's layer-height profile). Atomic.
 Expected<void> write_3mf(const std::filesystem::path& file, const TriangleMesh& mesh,
-                         const std::vector<PackageFile>& extra = {});
+                         const std::vector<PackageFile>& extra = {}, const Object3mf& object = {});
+
+/// The bytes of the part `name` ("Metadata/nonplanar_plan.json") of a 3MF (zip) package.
+/// Errors: io_error (the file), parse_error (not a zip, or no such part), naming the file.
+Expected<std::string> read_3mf_part(const std::filesystem::path& file, const std::string& name);
 
 /// ASCII PLY with one RGB colour per face (face_colors: F entries, 0xRRGGBB). Atomic.
 Expected<void> write_ply_face_colors(const std::filesystem::path& file, const TriangleMesh& mesh,

@@ -40,6 +40,9 @@ struct SliceJob {
   std::vector<Notice> notices;  ///< what make_job adapted (passed on to the result)
   PrintConfig print;
   bool planar_only = false;
+  /// A part with no curved stack may print as a shell over a planar core (prepare_part,
+  /// whose one slicer run cannot print a shell, turns this off).
+  bool shells = true;
   /// Another slicer instead of the built-in engine: it slices the normalised mesh with the
   /// user's profile and its G-code is mapped back (map_foreign_gcode). Layer heights and
   /// the bed come from `print`, which must agree with that profile.

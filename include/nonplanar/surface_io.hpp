@@ -26,6 +26,10 @@ struct SurfaceRecord {
 Expected<void> write_surfaces_json(const std::filesystem::path& file,
                                    const std::vector<SurfaceRecord>& surfaces);
 
+/// The same document as text (indent: as nlohmann::json::dump; -1 for one line), for a
+/// caller that embeds it in a file of its own (the print plan, print_plan.hpp).
+std::string surfaces_json(const std::vector<SurfaceRecord>& surfaces, int indent = -1);
+
 /// Reads what write_surfaces_json wrote; every surface is checked with valid().
 /// Errors: "FILE: what is wrong" (parse_error).
 Expected<std::vector<SurfaceRecord>> read_surfaces_json(const std::filesystem::path& file);

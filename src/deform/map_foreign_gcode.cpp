@@ -60,16 +60,29 @@ struct Writing {
   double retracted = 0;  ///< filament the print's own retractions leave pulled back
 };
 
+// Is m a move ForeignMapOptions::planar_lines keeps where the file has it?
+bool kept(const std::vector<char>& planar_lines, const GcodeMove& m) {
+  const auto k = static_cast<std::size_t>(m.line - 1);
+  return m.line > 0 && k < planar_lines.size() && planar_lines[k];
+}
+
 // Maps the layer's extrusions and wipes into work.mapped, and sets L's highest point and
 // steepest slope (which set how its travels clear it). Error past 50 million points.
 std::optional<Error> map_layer(LayerWork& work, const LayerField& field, double tolerance,
-                               LayerToolpaths& L, std::size_t& points) {
+                               const std::vector<char>& planar_lines, LayerToolpaths& L,
+                               std::size_t& points) {
   L.max_z = -1e300;
   for (const GcodeLine& it : work.lines) {
     if (it.kind != Kind::move) continue;
     const GcodeMove& m = work.moves[static_cast<std::size_t>(it.move)];
     if (!m.has_xy || !(m.extruding() || (m.wipe && m.de <= 0))) continue;
     ExtrusionPath& p = work.mapped[static_cast<std::size_t>(it.move)];
+    if (kept(planar_lines, m)) {
+      p.points = {m.from, m.to};
+      p.height = {m.height, m.height};
+      add_to_reach(p, L);
+      continue;
+    }
     const Mapped a = map_point(field, m.from, m.height), b = map_point(field, m.to, m.height);
     p.points.push_back(a.p);
     p.height.push_back(a.height);
@@ -126,15 +139,15 @@ void write_pieces(const GcodeMove& m, const ExtrusionPath& p, LayerToolpaths& L,
 // curved layers. A Z move stays where the nozzle is (not where the file's start G-code left
 // it, when the caller moved the start).
 void write_travel(const GcodeMove& m, const LayerField& field, const MapBackParams& params,
-                  const LayerToolpaths& L, Writing& s) {
+                  const LayerToolpaths& L, bool keep, Writing& s) {
   if (!m.has_xy && !m.has_z) {  // retraction, F only
     if (m.has_e) s.retracted -= m.de;
     s.w.move_from(s.at, s.at, m.has_e ? m.de + s.pending : kNoValue, m.f);
     if (m.has_e) s.pending = 0;
     return;
   }
-  const Mapped target =
-      map_point(field, m.has_xy ? m.to : Vec3(s.at.x(), s.at.y(), m.to.z()), m.height);
+  const Vec3 planar_to = m.has_xy ? m.to : Vec3(s.at.x(), s.at.y(), m.to.z());
+  const Mapped target = keep ? Mapped{planar_to, m.height} : map_point(field, planar_to, m.height);
   const Vec3 to = target.p;
   const bool curved =
       target.p.z() != m.to.z() || !field.planar_at(m.from.x(), m.from.y()) ||
@@ -155,7 +168,8 @@ void write_travel(const GcodeMove& m, const LayerField& field, const MapBackPara
 // Writes one mapped layer's lines; ;Z: becomes its highest point and ;HEIGHT: its mean
 // thickness (planar_h when it extrudes nothing).
 void write_layer(const LayerWork& work, const LayerField& field, const MapBackParams& params,
-                 double planar_h, LayerToolpaths& L, Writing& s) {
+                 const std::vector<char>& planar_lines, double planar_h, LayerToolpaths& L,
+                 Writing& s) {
   double h_sum = 0;
   std::size_t h_n = 0;
   long run = -1;  // the gate's path being extended
@@ -185,7 +199,7 @@ void write_layer(const LayerWork& work, const LayerField& field, const MapBackPa
       continue;
     }
     run = -1;
-    write_travel(m, field, params, L, s);
+    write_travel(m, field, params, L, kept(planar_lines, m), s);
   }
   char zbuf[32], hbuf[32];
   std::snprintf(zbuf, sizeof zbuf, ";Z:%.3f", L.max_z);
@@ -265,9 +279,12 @@ Expected<ForeignGcode> map_foreign_gcode(std::string_view text, const LayerField
         return Error{Status::invalid_argument,
                      "line " + std::to_string(bad) + ": more than 50 million clip samples"};
     }
-    if (auto e = map_layer(work, field, params.tolerance, out.layers[lu], points)) return *e;
+    if (auto e =
+            map_layer(work, field, params.tolerance, options.planar_lines, out.layers[lu], points))
+      return *e;
     program::order_top_skins(work);
-    write_layer(work, field, params, prog.layer_height[lu], out.layers[lu], s);
+    write_layer(work, field, params, options.planar_lines, prog.layer_height[lu], out.layers[lu],
+                s);
     if (ctx.cancelled()) return Error{Status::cancelled, "cancelled"};
   }
   out.print_end = s.w.out.size();

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "core/atomic_file.hpp"
+#include "core/file_bytes.hpp"
 #include "io/readers.hpp"
 #include "io/zip_package.hpp"
 
@@ -254,8 +255,54 @@ Expected<TriangleMesh> parse_3mf(std::string_view data, std::size_t max_triangle
 
 namespace nonplanar {
 
+namespace {
+
+std::string xml_escaped(const std::string& s) {
+  std::string out;
+  for (char c : s) {
+    switch (c) {
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      default:
+        out += c;
+    }
+  }
+  return out;
+}
+
+// PrusaSlicer's per-object configuration for object `id` (its name and settings, one volume
+// of all the faces).
+std::string slic3r_model_config(unsigned id, std::size_t faces, const Object3mf& o) {
+  std::string s = "<?xml version=\"1.0\" encoding=\"utf-8\"?>\n<config>\n <object id=\"" +
+                  std::to_string(id) + "\" instances_count=\"1\">\n";
+  auto meta = [&](const char* type, const std::string& k, const std::string& v) {
+    s += std::string("  <metadata type=\"") + type + "\" key=\"" + xml_escaped(k) + "\" value=\"" +
+         xml_escaped(v) + "\"/>\n";
+  };
+  if (!o.name.empty()) meta("object", "name", o.name);
+  for (const auto& [k, v] : o.settings) meta("object", k, v);
+  s += "  <volume firstid=\"0\" lastid=\"" + std::to_string(faces ? faces - 1 : 0) + "\">\n";
+  if (!o.name.empty())
+    s += "   <metadata type=\"volume\" key=\"name\" value=\"" + xml_escaped(o.name) + "\"/>\n";
+  s += "  </volume>\n </object>\n</config>\n";
+  return s;
+}
+
+}  // namespace
+
 Expected<void> write_3mf(const std::filesystem::path& file, const TriangleMesh& mesh,
-                         const std::vector<PackageFile>& extra) {
+                         const std::vector<PackageFile>& extra_files, const Object3mf& object) {
+  std::vector<PackageFile> extra = extra_files;
   using io::Handle;
   Handle model, obj, item, writer;
   if (NMR::lib3mf_createmodel(&model.p) != 0 ||
@@ -272,7 +319,19 @@ Expected<void> write_3mf(const std::filesystem::path& file, const TriangleMesh& 
       NMR::lib3mf_model_addbuilditem(model.p, obj.p, nullptr, &item.p) != 0 ||
       NMR::lib3mf_model_querywriter(model.p, "3mf", &writer.p) != 0)
     return Error{Status::internal_error, file.string() + ": " + io::last_error(model.p)};
-  if (!extra.empty()) NMR::lib3mf_model_addcustomcontenttypeutf8(model.p, "txt", "text/plain");
+  if (!object.name.empty() && NMR::lib3mf_object_setnameutf8(obj.p, object.name.c_str()) != 0)
+    return Error{Status::internal_error, file.string() + ": " + io::last_error(model.p)};
+  if (!object.name.empty() || !object.settings.empty()) {
+    DWORD id = 0;
+    NMR::lib3mf_resource_getresourceid(obj.p, &id);
+    extra.push_back(
+        {"/Metadata/Slic3r_PE_model.config", slic3r_model_config(id, mesh.faces.size(), object)});
+  }
+  if (!extra.empty()) {
+    NMR::lib3mf_model_addcustomcontenttypeutf8(model.p, "txt", "text/plain");
+    NMR::lib3mf_model_addcustomcontenttypeutf8(model.p, "config", "text/xml");
+    NMR::lib3mf_model_addcustomcontenttypeutf8(model.p, "json", "application/json");
+  }
   for (const PackageFile& f : extra) {
     Handle att;
     std::string path = f.path, type = "http://schemas.nonplanar.org/3mf/attachment";
@@ -291,6 +350,16 @@ Expected<void> write_3mf(const std::filesystem::path& file, const TriangleMesh& 
     out.write(reinterpret_cast<const char*>(buf.data()), static_cast<std::streamsize>(buf.size()));
     return bool(out);
   });
+}
+
+Expected<std::string> read_3mf_part(const std::filesystem::path& file, const std::string& name) {
+  auto bytes = core::read_file_bytes(file, std::size_t(1) << 31);
+  if (!bytes) return Error{bytes.error().status, file.string() + ": " + bytes.error().message};
+  auto part = io::zip_entry(bytes->view(), name);
+  if (!part)
+    return Error{Status::parse_error, file.string() + ": no " + name + " in it (is it a 3MF " +
+                                          "written by nonplanar prepare?)"};
+  return std::move(*part);
 }
 
 }  // namespace nonplanar

@@ -48,6 +48,30 @@ std::optional<std::string> inflate_raw(std::string_view in, std::size_t size) {
   return out;
 }
 
+// The ZIP64 extended-information field (tag 1) among an entry's extra fields: each of usize,
+// csize and local that reads 0xffffffff takes its 8-byte value from it. False when one is
+// marked but missing, or a value is beyond what this reader takes.
+bool zip64_sizes(std::string_view extra, std::uint64_t* usize, std::uint64_t* csize,
+                 std::uint64_t* local) {
+  std::uint64_t* marked[3] = {usize, csize, local};
+  std::size_t at = 0;
+  std::string_view info;
+  while (at + 4 <= extra.size()) {
+    const std::uint32_t tag = u16(extra, at), len = u16(extra, at + 2);
+    if (at + 4 + len > extra.size()) break;
+    if (tag == 1) info = extra.substr(at + 4, len);
+    at += 4 + len;
+  }
+  std::size_t next = 0;
+  for (std::uint64_t* v : marked) {
+    if (*v != 0xffffffff) continue;
+    if (next + 8 > info.size()) return false;
+    *v = u32(info, next) | (std::uint64_t(u32(info, next + 4)) << 32);
+    next += 8;
+  }
+  return *usize <= kMaxEntry && *csize <= kMaxEntry;
+}
+
 // Every entry, uncompressed, in central-directory order.
 std::optional<std::vector<Entry>> read_zip(std::string_view z) {
   if (z.size() < 22) return std::nullopt;
@@ -58,20 +82,36 @@ std::optional<std::vector<Entry>> read_zip(std::string_view z) {
       break;
     }
   if (eocd == std::string_view::npos) return std::nullopt;
-  const std::uint32_t count = u16(z, eocd + 10), cd = u32(z, eocd + 16);
+  std::uint64_t count = u16(z, eocd + 10), cd = u32(z, eocd + 16);
+  // ZIP64 (lib3mf's packages): the locator 20 bytes before points at the ZIP64 end record,
+  // which holds the entry count and the central directory's offset.
+  if (cd == 0xffffffff && eocd >= 20 && u32(z, eocd - 20) == 0x07064b50) {
+    const std::uint64_t rec = u32(z, eocd - 12) | (std::uint64_t(u32(z, eocd - 8)) << 32);
+    if (rec + 56 > z.size() || u32(z, static_cast<std::size_t>(rec)) != 0x06064b50)
+      return std::nullopt;
+    const auto r = static_cast<std::size_t>(rec);
+    count = u32(z, r + 32) | (std::uint64_t(u32(z, r + 36)) << 32);
+    cd = u32(z, r + 48) | (std::uint64_t(u32(z, r + 52)) << 32);
+    if (count > 65535 || cd > z.size()) return std::nullopt;
+  }
   std::vector<Entry> out;
-  std::size_t p = cd, total = 0;
-  for (std::uint32_t k = 0; k < count; ++k) {
+  std::size_t p = static_cast<std::size_t>(cd), total = 0;
+  for (std::uint64_t k = 0; k < count; ++k) {
     if (p + 46 > z.size() || u32(z, p) != 0x02014b50) return std::nullopt;
     const std::uint32_t flags = u16(z, p + 8), method = u16(z, p + 10);
-    const std::uint32_t csize = u32(z, p + 20), usize = u32(z, p + 24);
+    std::uint64_t csize = u32(z, p + 20), usize = u32(z, p + 24);
     const std::uint32_t n = u16(z, p + 28), e = u16(z, p + 30), c = u16(z, p + 32);
-    const std::size_t local = u32(z, p + 42);  // size_t: local + 30 must not wrap
-    if (p + 46 + n > z.size() || (flags & 1) || csize == 0xffffffff || local + 30 > z.size() ||
-        u32(z, local) != 0x04034b50)
+    std::uint64_t local = u32(z, p + 42);  // 64 bits: local + 30 must not wrap
+    if (p + 46 + n + e > z.size() || (flags & 1)) return std::nullopt;
+    // lib3mf writes every entry with a ZIP64 extra field: the sizes and offset marked
+    // 0xffffffff are there, in this order.
+    if (!zip64_sizes(z.substr(p + 46 + n, e), &usize, &csize, &local)) return std::nullopt;
+    if (local + 30 > z.size() || u32(z, static_cast<std::size_t>(local)) != 0x04034b50)
       return std::nullopt;
     Entry entry{std::string(z.substr(p + 46, n)), {}};
-    const std::size_t data = local + 30 + u16(z, local + 26) + u16(z, local + 28);
+    const std::size_t data = static_cast<std::size_t>(local) + 30 +
+                             u16(z, static_cast<std::size_t>(local) + 26) +
+                             u16(z, static_cast<std::size_t>(local) + 28);
     if (data + csize > z.size() || (total += usize) > kMaxEntry) return std::nullopt;
     const std::string_view raw = z.substr(data, csize);
     if (method == 0 && csize == usize) {
@@ -161,6 +201,15 @@ std::string prune(const std::string& rels_name, const std::string& xml,
 }
 
 }  // namespace
+
+std::optional<std::string> zip_entry(std::string_view zip, std::string_view name) {
+  if (!name.empty() && name[0] == '/') name.remove_prefix(1);
+  auto entries = read_zip(zip);
+  if (!entries) return std::nullopt;
+  for (Entry& e : *entries)
+    if (e.name == name) return std::move(e.data);
+  return std::nullopt;
+}
 
 std::optional<std::string> drop_dangling_relationships(std::string_view zip,
                                                        std::vector<std::string>* dropped) {

@@ -16,4 +16,8 @@ namespace nonplanar::io {
 std::optional<std::string> drop_dangling_relationships(std::string_view zip,
                                                        std::vector<std::string>* dropped);
 
+/// The uncompressed bytes of entry `name` (leading '/' ignored); nullopt when the zip cannot
+/// be read (as above) or has no such entry.
+std::optional<std::string> zip_entry(std::string_view zip, std::string_view name);
+
 }  // namespace nonplanar::io

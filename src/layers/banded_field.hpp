@@ -77,6 +77,7 @@ class BandedField final : public LayerField {
   /// False when the segment crosses a band's support box within the layers it bends.
   bool planar_along(const Vec2& a, const Vec2& b, double t_lo, double t_hi) const override;
   const std::vector<Band>& bands() const { return bands_; }
+  const PlanarLayers& planar() const { return pl_; }
   /// Where a band can bend the layers: β > 0 only inside [lo, hi] (XY), and the layers only
   /// between c and z_top (its top's highest point over that box, plus its fade), i.e. for
   /// layer coordinates in (T_bottom, t_top).

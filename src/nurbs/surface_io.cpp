@@ -84,13 +84,17 @@ SurfaceRecord from_json(const nlohmann::json& j) {
 
 }  // namespace
 
-Expected<void> write_surfaces_json(const std::filesystem::path& file,
-                                   const std::vector<SurfaceRecord>& surfaces) {
+std::string surfaces_json(const std::vector<SurfaceRecord>& surfaces, int indent) {
   ordered_json doc = {{"format", "nonplanar-surfaces"}, {"version", 1}, {"units", "mm"}};
   ordered_json arr = ordered_json::array();
   for (const auto& r : surfaces) arr.push_back(to_json(r));
   doc["surfaces"] = std::move(arr);
-  const std::string text = doc.dump(1) + "\n";
+  return doc.dump(indent) + "\n";
+}
+
+Expected<void> write_surfaces_json(const std::filesystem::path& file,
+                                   const std::vector<SurfaceRecord>& surfaces) {
+  const std::string text = surfaces_json(surfaces, 1);
   return write_file_atomically(file, [&](std::ostream& out) {
     out << text;
     return bool(out);

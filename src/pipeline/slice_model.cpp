@@ -252,8 +252,9 @@ Expected<SliceResult> slice_rounds(const TriangleMesh& mesh, const SliceJob& job
     // OrcaSlicer prints no shells (its command line cannot take our layer boundaries): with
     // it, a part without stacks slices planar at once.
     bool deferred = false;
-    auto r = attempt(mesh, job, pre, excluded, &offenders,
-                     job.engine.engine != Engine::orcaslicer ? &deferred : nullptr, ctx);
+    auto r =
+        attempt(mesh, job, pre, excluded, &offenders,
+                job.shells && job.engine.engine != Engine::orcaslicer ? &deferred : nullptr, ctx);
     if (!r) return r;
     if (deferred) {
       // No curved stack: a shell, or else the same attempt sliced planar (its stacks cached).

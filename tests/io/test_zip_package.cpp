@@ -61,6 +61,30 @@ TEST(ZipPackage, AThumbnailNamedButMissingIsDroppedAndTheModelLoads) {
   EXPECT_FALSE(io::drop_dangling_relationships(hostile, nullptr));
 }
 
+// lib3mf writes ZIP64 packages (every size in an extra field, the directory's offset in a
+// ZIP64 end record): a part of ours reads back from one, by name.
+TEST(ZipPackage, PartsOfOurOwn3mfReadBack) {
+  const fs::path d = test::temp_dir("zip_parts");
+  const std::string plan(300000, 'x');
+  ASSERT_TRUE(write_3mf(d / "p.3mf", test::box({0, 0, 0}, {20, 10, 5}),
+                        {{"/Metadata/nonplanar_plan.json", plan}},
+                        {"part", {{"layer_height", "0.2"}}}));
+  auto back = read_3mf_part(d / "p.3mf", "Metadata/nonplanar_plan.json");
+  ASSERT_TRUE(back) << back.error().message;
+  EXPECT_EQ(*back, plan);
+  auto cfg = read_3mf_part(d / "p.3mf", "/Metadata/Slic3r_PE_model.config");
+  ASSERT_TRUE(cfg);
+  EXPECT_NE(cfg->find("key=\"layer_height\" value=\"0.2\""), std::string::npos) << *cfg;
+  EXPECT_NE(cfg->find("key=\"name\" value=\"part\""), std::string::npos);
+  auto missing = read_3mf_part(d / "p.3mf", "Metadata/other.json");
+  ASSERT_FALSE(missing);
+  EXPECT_NE(missing.error().message.find("no Metadata/other.json in it"), std::string::npos);
+  // The mesh still loads, named parts and all.
+  auto m = load_mesh(d / "p.3mf", {}, {});
+  ASSERT_TRUE(m) << m.error().message;
+  EXPECT_EQ(m->mesh.faces.size(), 12u);
+}
+
 TEST(ZipPackage, PrusaSlicersOwnExportLoads) {
   if (std::system("command -v prusa-slicer >/dev/null 2>&1") != 0)
     GTEST_SKIP() << "prusa-slicer not installed";

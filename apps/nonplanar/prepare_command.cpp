@@ -1,0 +1,141 @@
+// `nonplanar prepare`: plan the curved layers and write the normalised part as a 3MF, with
+// the plan inside it, for the user's own slicer; its post-processing script
+// (`nonplanar post-process`) maps the G-code back.
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+
+#include "cli_common.hpp"
+#include "commands.hpp"
+#include "nonplanar/print_plan.hpp"
+#include "nonplanar/print_time.hpp"
+
+namespace nonplanar::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct PrepareOptions {
+  MeshOptions mesh;
+  ProfileOptions profile;
+  std::string output;
+  double max_angle = 30.0;
+};
+
+// Where -o points: a folder (existing, or ending in '/') gets MODEL.3mf.
+std::string output_file(const PrepareOptions& o) {
+  const fs::path out(o.output);
+  if (fs::is_directory(out) || (!o.output.empty() && o.output.back() == '/'))
+    return (out / fs::path(o.mesh.model).stem()).string() + ".3mf";
+  return o.output;
+}
+
+std::string num(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3g", v);
+  return buf;
+}
+
+// The absolute path of this executable, for the line to paste into the slicer.
+std::string self_path() {
+  std::error_code ec;
+  const fs::path p = fs::read_symlink("/proc/self/exe", ec);
+  return ec ? std::string("nonplanar") : p.string();
+}
+
+std::string quoted(const std::string& s) {
+  if (s.find_first_of(" '\"\\$`") == std::string::npos) return s;
+  std::string q = "'";
+  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+void print_instructions(const std::string& out, const PreparedPart& part) {
+  const PrintPlan& p = part.plan;
+  std::fprintf(stderr, "wrote %s: %s, %zu curved stack%s\n", out.c_str(), p.object.c_str(),
+               part.stacks, part.stacks == 1 ? "" : "s");
+  std::fprintf(
+      stderr,
+      "In PrusaSlicer or OrcaSlicer, open it with your own printer and filament, and keep:\n"
+      "  - layer height %s mm (set on the object) and first layer height %s mm;\n"
+      "  - variable layer height and arc fitting off; no scaling or rotating (moving is "
+      "fine);\n"
+      "  - this post-processing script (Print Settings > Output options):\n"
+      "      %s post-process --plan %s\n",
+      num(p.layer_height).c_str(), num(p.first_layer_height).c_str(), quoted(self_path()).c_str(),
+      quoted(fs::absolute(out).string()).c_str());
+}
+
+int run(const PrepareOptions& o) {
+  auto cfg = o.profile.load();
+  if (!cfg) return report_error(cfg.error());
+  if (auto a = check_max_angle(o.max_angle); !a) return report_error(a.error());
+  const std::string out = output_file(o);
+  if (fs::path(out).extension() != ".3mf")
+    return report_error({Status::invalid_argument, "-o " + out + ": prepare writes a .3mf"});
+  std::vector<std::string> inputs = o.profile.config;
+  inputs.push_back(o.mesh.model);
+  if (auto c = check_outputs(inputs, {out}); !c) return report_error(c.error());
+  SliceJob job = make_job(*cfg, o.max_angle);
+  if (!o.mesh.quiet)
+    for (const Notice& n : job.notices) std::fprintf(stderr, "notice: %s\n", n.text.c_str());
+  Context ctx = make_context(o.mesh.quiet);
+  LoadParams lp = o.mesh.load;
+  lp.bed_center = cfg->bed_center();
+  auto loaded = load_mesh(o.mesh.model, lp, ctx);
+  if (!loaded) return finish_progress(), report_error(loaded.error());
+  job.header.push_back("model: " + o.mesh.model);
+  auto part = prepare_part(loaded->mesh, job, ctx);
+  if (!part) {
+    finish_progress();
+    Error e = part.error();
+    if (e.status == Status::unsupported || e.status == Status::invalid_mesh)
+      e = {Status::invalid_argument, o.mesh.model + ": " + e.message};
+    return report_error(e);
+  }
+  part->plan.object = fs::path(o.mesh.model).stem().string();
+  part->plan.model = fs::path(o.mesh.model).filename().string();
+  Object3mf object{part->plan.object, {{"layer_height", num(part->plan.layer_height)}}};
+  auto w = write_3mf(out, part->normalized,
+                     {{"/Metadata/nonplanar_plan.json", plan_json(part->plan)}}, object);
+  finish_progress();
+  if (!w) return report_error(w.error());
+  report_warnings(o.mesh.model, *loaded, o.mesh.quiet);
+  if (!o.mesh.quiet) {
+    for (const Notice& n : part->notices)
+      if (n.kind != Notice::Kind::summary) std::fprintf(stderr, "notice: %s\n", n.text.c_str());
+    print_instructions(out, *part);
+  }
+  return kExitOk;
+}
+
+}  // namespace
+
+void register_prepare(CLI::App& app, std::function<int()>* run_fn) {
+  auto o = std::make_shared<PrepareOptions>();
+  CLI::App* cmd = app.add_subcommand(
+      "prepare",
+      "Plan the curved layers of a model for your own slicer: write the normalised part as a\n"
+      "3MF (the plan inside it) to slice in PrusaSlicer or OrcaSlicer with your profile; its\n"
+      "post-processing script, 'nonplanar post-process', maps the G-code back. Give the\n"
+      "profile you will slice with (--config or presets): the plan is made for its layers.");
+  o->mesh.add_to(*cmd);
+  cmd->add_option("-o,--output", o->output,
+                  "3MF file to write (atomically); a folder gets MODEL.3mf")
+      ->required();
+  o->profile.add_to(*cmd, "the printer, print and filament you will slice with");
+  o->profile.add_keyed(*cmd, "--layer-height", "layer_height", "Layer height (mm)");
+  o->profile.add_keyed(*cmd, "--first-layer-height", "first_layer_height",
+                       "First layer height (mm or %)");
+  o->profile.add_keyed(*cmd, "--min-layer-height", "min_layer_height",
+                       "Thinnest curved layer, h_min (mm; 0 = automatic)");
+  o->profile.add_keyed(*cmd, "--max-layer-height", "max_layer_height",
+                       "Thickest curved layer, h_max (mm; 0 = automatic)");
+  cmd->add_option("--max-angle", o->max_angle,
+                  "Steepest surface printed non-planar, degrees (nozzle geometry)")
+      ->capture_default_str();
+  *run_fn = nullptr;
+  cmd->callback([o, run_fn] { *run_fn = [o] { return run(*o); }; });
+}
+
+}  // namespace nonplanar::cli

@@ -1,0 +1,76 @@
+// Curved tops from inside the user's own slicer (README, "Use it from PrusaSlicer /
+// OrcaSlicer"): `prepare` plans the curved layers and writes the normalised part, which the
+// slicer slices with the user's own profile; its post-processing script (`post-process`)
+// maps the G-code back with the same plan. The plan travels in the 3MF
+// (Metadata/nonplanar_plan.json, docs/plan-format.md). Units: mm, degrees.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "nonplanar/pipeline.hpp"
+
+namespace nonplanar {
+
+/// What post-process needs to know of the plan: the field, where the normalised part stood,
+/// the layers it was planned for and the limits and head it was checked against.
+struct PrintPlan {
+  std::string object;  ///< the part's name in the 3MF (the model file's stem)
+  std::string model;   ///< the model file prepare read (for messages)
+  BoundingBox box;     ///< the normalised part on the bed, as prepare placed it
+  double layer_height = 0.2, first_layer_height = 0.2;
+  double min_layer_height = 0.1, max_layer_height = 0.3, max_angle_deg = 30;
+  Toolhead toolhead;
+  std::vector<std::string> header;  ///< what is curved, for the G-code's header
+  std::string field;                ///< the layer field as text (field_io.hpp)
+};
+
+/// The plan as JSON text (docs/plan-format.md).
+std::string plan_json(const PrintPlan& plan);
+/// Reads what plan_json wrote, every value checked. Errors: parse_error, unsupported (a
+/// newer version).
+Expected<PrintPlan> parse_plan_json(std::string_view text);
+
+/// prepare's output: the normalised part to slice, and its plan.
+struct PreparedPart {
+  TriangleMesh normalized;
+  PrintPlan plan;
+  std::shared_ptr<const LayerField> field;  ///< the plan's field (plan.field as read back)
+  std::vector<Notice> notices;              ///< as slice_model's (patches printed planar and why)
+  std::size_t stacks = 0;                   ///< curved stacks in the plan
+};
+
+/// Inputs: the part placed on the bed, the job (its engine is ignored: the plan is checked by
+/// slicing it with the built-in engine, retries and all, as `slice` does). Output: the
+/// normalised part and the plan of the stacks that passed. A shell over a planar core takes
+/// two slicer runs, which one post-processing step cannot give, so shells are not planned.
+/// Errors: unsupported when nothing prints curved (the message says why), those of
+/// slice_model, cancelled.
+Expected<PreparedPart> prepare_part(const TriangleMesh& placed, SliceJob job, const Context& ctx);
+
+/// What post_process_gcode did.
+struct PostProcessed {
+  std::string gcode;       ///< the whole file, mapped back
+  Vec2 moved{0, 0};        ///< where the slicer put the part relative to the plan, mm
+  std::size_t layers = 0;  ///< layers of the print
+  double thickness_min = 0, thickness_max = 0, steepest_deg = 0;
+  PrintStats stats;
+};
+
+/// Maps a slicer's G-code of the prepared part back onto the curved layers (the same passes
+/// as `slice --engine`: map_foreign_gcode, the safety gate, the time and filament). The
+/// printer and its limits come from the file's own settings block; the layers, limits and
+/// head from the plan. Refused (invalid_argument, naming the setting or what to change): a
+/// file already post-processed, no settings block, another layer height or first layer
+/// height, arc fitting, spiral vase, variable layer height, a part scaled or rotated (its
+/// extrusions' box against the plan's), more than the planned part on the plate; a
+/// violation of the limits (internal_error names where).
+Expected<PostProcessed> post_process_gcode(std::string_view gcode, const PrintPlan& plan,
+                                           const Context& ctx);
+
+/// The first line post_process_gcode writes (how a file already post-processed is known).
+inline constexpr std::string_view kPostProcessedMark = "; post-processed by nonplanar";
+
+}  // namespace nonplanar

@@ -1,0 +1,290 @@
+// prepare_part and post_process_gcode (print_plan.hpp): the slicer's own route, split at its
+// post-processing hook.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+
+#include "nonplanar/config.hpp"
+#include "nonplanar/field_io.hpp"
+#include "nonplanar/print_plan.hpp"
+#include "nonplanar/program.hpp"
+#include "pipeline/gate.hpp"
+
+namespace nonplanar {
+
+Expected<PreparedPart> prepare_part(const TriangleMesh& placed, SliceJob job, const Context& ctx) {
+  job.engine = EngineParams{};  // checked with the built-in engine
+  job.shells = false;
+  auto r = slice_model(placed, job, ctx);
+  if (!r) return r.error();
+  if (r->plan.stacks.empty() || !r->plan.field) {
+    std::string why = "no surface needs curved layers";
+    for (const Notice& n : r->notices)
+      if (n.kind == Notice::Kind::summary) why = n.text;
+    return Error{Status::unsupported,
+                 "nothing prints curved, so there is nothing to prepare (" + why +
+                     "); slice it as it is ('nonplanar slice' may still print its top as a "
+                     "curved shell over a planar core, which one slicer run cannot)"};
+  }
+  auto normalized = normalize_mesh(placed, *r->plan.field, {}, ctx);
+  if (!normalized) return normalized.error();
+  auto field = layer_field_json(*r->plan.field);
+  if (!field) return field.error();
+  PreparedPart out;
+  out.normalized = std::move(normalized->mesh);
+  out.notices = std::move(r->notices);
+  out.stacks = r->plan.stacks.size();
+  out.field = r->plan.field;
+  PrintPlan& p = out.plan;
+  p.box = bounding_box(out.normalized);
+  p.layer_height = job.layers.layer_height;
+  p.first_layer_height = job.layers.first_layer_height;
+  p.min_layer_height = job.layers.min_layer_height;
+  p.max_layer_height = job.layers.max_layer_height;
+  p.max_angle_deg = job.layers.max_angle_deg;
+  p.toolhead = job.layers.toolhead;
+  p.header = r->header;
+  p.field = std::move(*field);
+  return out;
+}
+
+namespace {
+
+Error refuse(const std::string& why) {
+  return Error{Status::invalid_argument, why};
+}
+
+// "key = value" of the settings block (empty when the key is not there).
+std::string block_value(const std::string& block, const std::string& key) {
+  const std::string head = key + " = ";
+  for (std::size_t at = 0; at < block.size();) {
+    const std::size_t end = std::min(block.find('\n', at), block.size());
+    if (block.compare(at, head.size(), head) == 0)
+      return block.substr(at + head.size(), end - at - head.size());
+    at = end + 1;
+  }
+  return "";
+}
+
+// A label's object name without the slicer's id and copy ("dome id:0 copy 0", "dome_id_0_copy_0",
+// "dome.stl") and quotes.
+std::string object_name(std::string n) {
+  for (const char* cut : {" id:", "_id_"})
+    if (auto at = n.find(cut); at != std::string::npos) n.resize(at);
+  while (!n.empty() && (n.back() == '"' || n.back() == '\'' || n.back() == ' ')) n.pop_back();
+  while (!n.empty() && (n.front() == '"' || n.front() == '\'')) n.erase(0, 1);
+  for (const char* ext : {".stl", ".STL", ".3mf", ".3MF", ".obj", ".OBJ", ".step", ".stp"})
+    if (n.size() > std::strlen(ext) &&
+        n.compare(n.size() - std::strlen(ext), std::string::npos, ext) == 0)
+      n.resize(n.size() - std::strlen(ext));
+  return n;
+}
+
+// What an object-label line says: the object that starts (its name), or that one ends.
+enum class Label { none, start, end };
+Label label_of(std::string_view raw, std::string* name) {
+  static const std::pair<std::string_view, Label> kHeads[] = {
+      {"; printing object ", Label::start},
+      {"; stop printing object", Label::end},
+      {"EXCLUDE_OBJECT_START NAME=", Label::start},
+      {"EXCLUDE_OBJECT_END", Label::end}};
+  for (const auto& [head, kind] : kHeads)
+    if (raw.substr(0, head.size()) == head) {
+      if (kind == Label::start) *name = object_name(std::string(raw.substr(head.size(), 200)));
+      return kind;
+    }
+  return Label::none;
+}
+
+// The part's outline in the slicer's words (PrusaSlicer's, OrcaSlicer's): supports and the
+// brim reach beyond it (PrusaSlicer 2.5's support base grows 5 mm past the part).
+bool outline(std::string_view type) {
+  return type == "External perimeter" || type == "Overhang perimeter" || type == "Outer wall" ||
+         type == "Overhang wall";
+}
+bool not_the_part(std::string_view type) {
+  return type == "Skirt/Brim" || type == "Skirt" || type == "Brim" ||
+         type.find("Support") != std::string_view::npos ||
+         type.find("support") != std::string_view::npos;
+}
+
+// The settings the plan needs kept, checked against the file: the layers as sliced (a
+// per-object layer height does not show in the block, so the ;HEIGHT: of each layer is
+// read), arc fitting, spiral vase.
+std::optional<Error> settings_kept(const GcodeProgram& prog, const std::vector<char>& ours,
+                                   const std::string& block, const PrintPlan& plan) {
+  char buf[300];
+  const auto& h = prog.layer_height;
+  if (h.empty())
+    return refuse("no ;LAYER_CHANGE in the file: is it PrusaSlicer's or OrcaSlicer's?");
+  if (std::abs(h[0] - plan.first_layer_height) > 1e-3) {
+    std::snprintf(buf, sizeof buf,
+                  "the first layer is %.3f mm, the plan's %.3f mm: set first_layer_height = %.3f "
+                  "(Print Settings > Layers and perimeters), or prepare again with yours",
+                  h[0], plan.first_layer_height, plan.first_layer_height);
+    return refuse(buf);
+  }
+  // The part's beads (not the supports', which PrusaSlicer puts on layers of their own between
+  // the part's); its last layer may be thinner (the top is not on a layer boundary everywhere).
+  auto of_part = [&](std::size_t i) {
+    return ours[i] && prog.moves[i].extruding() && !not_the_part(prog.moves[i].type);
+  };
+  int first = -1, last = 0;
+  for (std::size_t i = 0; i < prog.moves.size(); ++i)
+    if (of_part(i)) {
+      if (first < 0) first = prog.moves[i].layer;
+      last = std::max(last, prog.moves[i].layer);
+    }
+  for (std::size_t i = 0; i < prog.moves.size(); ++i) {
+    const GcodeMove& m = prog.moves[i];
+    if (of_part(i) && m.layer > first && m.layer < last &&
+        std::abs(m.height - plan.layer_height) > 1e-3) {
+      std::snprintf(buf, sizeof buf,
+                    "layer %d is %.3f mm (line %d), the plan's layers %.3f mm: keep layer_height = "
+                    "%.3f on the object and variable layer height off, or prepare again with yours",
+                    m.layer + 1, m.height, m.line, plan.layer_height, plan.layer_height);
+      return refuse(buf);
+    }
+  }
+  const std::string arcs = block_value(block, "arc_fitting");
+  if (!arcs.empty() && arcs != "disabled" && arcs != "0")
+    return refuse("arc_fitting = " + arcs +
+                  ": arcs cannot follow curved layers; set "
+                  "arc_fitting = disabled (Print Settings > Advanced)");
+  if (block_value(block, "spiral_vase") == "1")
+    return refuse("spiral_vase = 1: a spiral vase has no layers to map; switch it off");
+  return std::nullopt;
+}
+
+// Where the slicer put the part: the box of its outline (its outer perimeters; without any,
+// every extrusion of the part) against the plan's. A part keeps its size when only moved;
+// scaled, rotated, or with other objects on the plate, the box's size differs.
+Expected<Vec2> placement(const GcodeProgram& prog, const std::vector<char>& ours,
+                         const PrintPlan& plan) {
+  BoundingBox b;
+  for (const bool outer_only : {true, false}) {
+    for (std::size_t i = 0; i < prog.moves.size(); ++i) {
+      const GcodeMove& m = prog.moves[i];
+      if (ours[i] && m.layer >= 0 && m.extruding() &&
+          (outer_only ? outline(m.type) : !not_the_part(m.type)))
+        b.extend(m.from), b.extend(m.to);
+    }
+    if (!b.empty()) break;
+  }
+  if (b.empty()) return refuse("the file extrudes nothing but skirt, brim and supports");
+  const Vec2 got = b.size().head<2>(), want = plan.box.size().head<2>();
+  // Perimeters lie half a width inside the part; a part is never wider than itself.
+  for (int k = 0; k < 2; ++k)
+    if (got[k] > want[k] + 0.2 || got[k] < want[k] - 2.0) {
+      char buf[320];
+      std::snprintf(buf, sizeof buf,
+                    "the part in the G-code is %.1f x %.1f mm, the plan's %.1f x %.1f mm: it was "
+                    "scaled or rotated after prepare (move it, but do not scale or rotate it), "
+                    "or the plate holds other objects (switch on Label objects, Print Settings > "
+                    "Output options, so post-process can tell them apart)",
+                    got.x(), got.y(), want.x(), want.y());
+      return refuse(buf);
+    }
+  return Vec2(0.5 * (b.min + b.max).head<2>() - 0.5 * (plan.box.min + plan.box.max).head<2>());
+}
+
+// Which moves are the planned part's: with object labels in the file, all but those between
+// another object's start and end labels; without, all of them. Refused when labels name other
+// objects only.
+Expected<std::vector<char>> moves_of_part(const GcodeProgram& prog, const PrintPlan& plan) {
+  std::vector<char> ours(prog.moves.size(), 1);
+  std::vector<std::string> names;
+  std::string current, name;
+  for (const GcodeLine& l : prog.lines) {
+    const Label k = l.kind == GcodeLine::Kind::text ? label_of(l.raw, &name) : Label::none;
+    if (k == Label::start) {
+      current = name;
+      if (std::find(names.begin(), names.end(), name) == names.end()) names.push_back(name);
+    }
+    if (k == Label::end) current.clear();
+    // Moves outside every label (travels between objects, layer changes) are the field's.
+    if (l.kind == GcodeLine::Kind::move && l.move >= 0)
+      ours[l.move] = current.empty() || current == plan.object;
+  }
+  if (names.empty()) return std::vector<char>(prog.moves.size(), 1);
+  if (std::find(names.begin(), names.end(), plan.object) == names.end()) {
+    std::string list;
+    for (const std::string& n : names) list += (list.empty() ? "" : ", ") + n;
+    return refuse("the plate's objects are " + list + "; none is " + plan.object +
+                  ", the plan's (keep the name prepare gave it)");
+  }
+  return ours;
+}
+
+}  // namespace
+
+Expected<PostProcessed> post_process_gcode(std::string_view gcode, const PrintPlan& plan,
+                                           const Context& ctx) {
+  if (gcode.substr(0, kPostProcessedMark.size()) == kPostProcessedMark)
+    return refuse("already post-processed by nonplanar (mapping it twice would lift it twice)");
+  const std::string block = gcode_config_block(gcode);
+  if (block.empty())
+    return refuse(
+        "no settings block at its end: post-process reads PrusaSlicer's and "
+        "OrcaSlicer's G-code (is this file complete?)");
+  auto cfg = parse_ini_config(block);
+  if (!cfg) return refuse("its settings block: " + cfg.error().message);
+  const GcodeProgram prog = read_gcode_program(gcode);
+  auto ours = moves_of_part(prog, plan);
+  if (!ours) return ours.error();
+  auto moved = placement(prog, *ours, plan);
+  if (!moved) return moved.error();
+  if (auto e = settings_kept(prog, *ours, block, plan)) return *e;
+  // The plan's layers, limits and head; the file's printer for everything else.
+  cfg->slice.layer_height = plan.layer_height;
+  cfg->slice.first_layer_height = plan.first_layer_height;
+  cfg->min_layer_height = plan.min_layer_height;
+  cfg->max_layer_height = plan.max_layer_height;
+  cfg->toolhead = plan.toolhead;
+  SliceJob job = make_job(*cfg, plan.max_angle_deg);
+  auto field = parse_layer_field_json(plan.field, *moved);
+  if (!field) return field.error();
+  // Other objects on the plate stay as the slicer put them.
+  ForeignMapOptions options;
+  if (std::find(ours->begin(), ours->end(), 0) != ours->end()) {
+    options.planar_lines.assign(prog.lines.size(), 0);
+    for (std::size_t i = 0; i < prog.moves.size(); ++i)
+      if (!(*ours)[i] && prog.moves[i].line > 0)
+        options.planar_lines[static_cast<std::size_t>(prog.moves[i].line - 1)] = 1;
+  }
+  auto mapped = map_foreign_gcode(gcode, **field, job.map_back, ctx, options);
+  if (!mapped) return mapped.error();
+  SliceResult r;
+  r.layers = std::move(mapped->layers);
+  r.nonplanar = true;
+  char buf[240];
+  std::snprintf(buf, sizeof buf, "%s %s from %s (plan of %s; the part moved by %.3f, %.3f mm)\n",
+                kPostProcessedMark.data(), "0.1.0", plan.object.c_str(), plan.model.c_str(),
+                moved->x(), moved->y());
+  std::string head = buf;
+  for (const std::string& h : plan.header) head += "; " + h + "\n";
+  r.gcode = head + mapped->text;
+  std::string breach;
+  auto ok = gate(
+      r, job, dynamic_cast<const layers::BandedField*>(field->get()),
+      [&](const Vec3& p, const char* what) {
+        std::snprintf(buf, sizeof buf, "%s at (%.2f, %.2f, %.2f)", what, p.x(), p.y(), p.z());
+        breach = buf;
+        return false;
+      },
+      ctx);
+  if (!ok) return ok.error();
+  if (!*ok)
+    return Error{Status::internal_error,
+                 "safety check: " + breach + "; the file is left as the slicer wrote it"};
+  PostProcessed out;
+  out.gcode = with_print_stats(r.gcode, *cfg, &out.stats);
+  out.moved = *moved;
+  out.layers = r.layers.size();
+  out.thickness_min = r.thickness_min, out.thickness_max = r.thickness_max;
+  out.steepest_deg = r.steepest_deg;
+  return out;
+}
+
+}  // namespace nonplanar

@@ -1,0 +1,250 @@
+// Curved tops from inside PrusaSlicer (#17): `prepare` writes the normalised part as a 3MF,
+// PrusaSlicer slices it with its post-processing script set to `post-process`, which maps
+// the G-code back. Run with Debian's prusa-slicer as a user would; skipped without it.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "nonplanar/io.hpp"
+#include "support/cli.hpp"
+#include "support/solids.hpp"
+
+namespace nonplanar {
+namespace {
+
+namespace fs = std::filesystem;
+
+bool have_prusaslicer() {
+  return std::system("command -v prusa-slicer >/dev/null 2>&1") == 0;
+}
+
+// prusa-slicer ARGS; its exit code, and its log in *log.
+int prusa(const std::string& args, std::string* log = nullptr) {
+  const fs::path dir = test::temp_dir("prusa_run");
+  const int st = std::system(
+      ("timeout -s KILL 300 prusa-slicer " + args + " >" + (dir / "log").string() + " 2>&1")
+          .c_str());
+  if (log) *log = test::read_bytes(dir / "log");
+  return WIFEXITED(st) ? WEXITSTATUS(st) : 128;
+}
+
+std::string post_process_line(const fs::path& plan) {
+  return std::string("--post-process '") + NONPLANAR_CLI + " post-process --plan " + plan.string() +
+         "'";
+}
+
+nlohmann::json figures(const fs::path& gcode, const fs::path& mesh) {
+  const auto c = test::run_cli("check -q --json " + gcode.string() + " --mesh " + mesh.string());
+  EXPECT_EQ(c.code, 0) << c.err;
+  return c.code == 0 ? nlohmann::json::parse(c.out) : nlohmann::json{};
+}
+
+// A part `prepare` wrote for `mesh`: dir/NAME.stl and dir/NAME.3mf.
+fs::path prepared(const fs::path& dir, const std::string& name, const TriangleMesh& mesh) {
+  EXPECT_TRUE(write_stl(dir / (name + ".stl"), mesh));
+  const auto r = test::run_cli("prepare " + (dir / (name + ".stl")).string() + " -o " +
+                               (dir / (name + ".3mf")).string());
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("post-process --plan " + (dir / (name + ".3mf")).string()),
+            std::string::npos)
+      << r.err;
+  return dir / (name + ".3mf");
+}
+
+TEST(PostProcessRoute, CurvedTopsLikeTheEngineRoute) {
+  if (!have_prusaslicer()) GTEST_SKIP() << "prusa-slicer not installed";
+  const fs::path dir = test::temp_dir("pp_route");
+  for (const auto& [name, mesh] :
+       {std::pair{"dome", test::dome_cut_by_box()}, {"saddle", test::saddle()}}) {
+    SCOPED_TRACE(name);
+    const fs::path plan = prepared(dir, name, mesh), out = dir / (std::string(name) + ".gcode");
+    std::string log;
+    ASSERT_EQ(prusa("--export-gcode --first-layer-height 0.2 " + post_process_line(plan) + " -o " +
+                        out.string() + " " + plan.string(),
+                    &log),
+              0)
+        << log;
+    const std::string text = test::read_bytes(out);
+    // PrusaSlicer centres the part on its own 200 mm bed; the plan was made on our 220 mm one.
+    EXPECT_NE(text.find("the part moved by -10.000, -10.000 mm"), std::string::npos);
+    const auto ours = figures(out, dir / (std::string(name) + ".stl"));
+    EXPECT_LE(ours["top_surface_deviation"]["p95"].get<double>(), 0.02);
+    EXPECT_EQ(ours["collisions"], 0);
+    EXPECT_GT(ours["steepest_extrusion"].get<double>(), 10);
+    const fs::path engine = dir / (std::string(name) + ".engine.gcode");
+    const auto e =
+        test::run_cli("slice -q " + (dir / (std::string(name) + ".stl")).string() +
+                      " --engine prusaslicer --first-layer-height 0.2 -o " + engine.string());
+    ASSERT_EQ(e.code, 0) << e.err;
+    const auto theirs = figures(engine, dir / (std::string(name) + ".stl"));
+    EXPECT_NEAR(ours["top_surface_deviation"]["p95"].get<double>(),
+                theirs["top_surface_deviation"]["p95"].get<double>(), 0.005);
+    EXPECT_NEAR(ours["volume_ratio"].get<double>(), theirs["volume_ratio"].get<double>(), 0.02);
+  }
+}
+
+// As the GUI runs it: the script gets NAME.gcode.pp in a temporary folder and the final name
+// in SLIC3R_PP_OUTPUT_NAME; the plan is the 3MF of that name, or the one holding the object
+// the labels name.
+TEST(PostProcessRoute, FindsThePlanAsTheSlicerRunsIt) {
+  if (!have_prusaslicer()) GTEST_SKIP() << "prusa-slicer not installed";
+  const fs::path dir = test::temp_dir("pp_find");
+  const fs::path plan = prepared(dir, "dome", test::dome_cut_by_box());
+  const fs::path raw = dir / "raw.gcode";
+  ASSERT_EQ(
+      prusa("--export-gcode --first-layer-height 0.2 -o " + raw.string() + " " + plan.string()), 0);
+  fs::create_directories(dir / "tmp");
+  const fs::path pp = dir / "tmp" / "7f3a.gcode.pp";
+  fs::copy_file(raw, pp);
+  const auto lost = test::run_cli("post-process " + pp.string());
+  EXPECT_EQ(lost.code, 2);  // without the final name there is no plan beside the temporary file
+  EXPECT_NE(lost.err.find("no plan found (looked for " + (dir / "tmp" / "7f3a.3mf").string()),
+            std::string::npos)
+      << lost.err;
+  setenv("SLIC3R_PP_OUTPUT_NAME", (dir / "dome.gcode").c_str(), 1);
+  const auto r = test::run_cli("post-process " + pp.string());
+  unsetenv("SLIC3R_PP_OUTPUT_NAME");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("mapped dome.gcode onto the curved layers of dome"), std::string::npos)
+      << r.err;
+  EXPECT_EQ(test::read_bytes(pp).rfind("; post-processed by nonplanar", 0), 0u);
+  // Object labels name the part; the G-code is named otherwise.
+  const fs::path labelled = dir / "whatever.gcode";
+  std::string log;
+  ASSERT_EQ(prusa("--export-gcode --first-layer-height 0.2 --gcode-label-objects --post-process '" +
+                      std::string(NONPLANAR_CLI) + " post-process' -o " + labelled.string() + " " +
+                      plan.string(),
+                  &log),
+            0)
+      << log;
+  EXPECT_LE(figures(labelled, dir / "dome.stl")["top_surface_deviation"]["p95"].get<double>(),
+            0.02);
+}
+
+TEST(PostProcessRoute, RefusalsLeaveTheSlicersFileUntouched) {
+  if (!have_prusaslicer()) GTEST_SKIP() << "prusa-slicer not installed";
+  const fs::path dir = test::temp_dir("pp_refuse");
+  const fs::path plan = prepared(dir, "dome", test::dome_cut_by_box());
+  struct Case {
+    std::string prusa_args, says;
+  };
+  for (const Case& c : {Case{"", "the first layer is 0.350 mm, the plan's 0.200 mm"},
+                        Case{"--first-layer-height 0.2 --rotate 30", "scaled or rotated"},
+                        Case{"--first-layer-height 0.2 --scale 110%", "scaled or rotated"}}) {
+    SCOPED_TRACE(c.prusa_args);
+    const fs::path out = dir / "out.gcode";
+    ASSERT_EQ(prusa("--export-gcode " + c.prusa_args + " -o " + out.string() + " " + plan.string()),
+              0);
+    const std::string before = test::read_bytes(out);
+    const auto r = test::run_cli("post-process --plan " + plan.string() + " " + out.string());
+    EXPECT_EQ(r.code, 2);
+    EXPECT_EQ(r.err.rfind("error: " + out.string() + ": ", 0), 0u) << r.err;
+    EXPECT_NE(r.err.find(c.says), std::string::npos) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_EQ(test::read_bytes(out), before);
+  }
+}
+
+// Supports and brim are the slicer's: they are mapped with the field like everything else.
+TEST(PostProcessRoute, SupportsAndBrimFollow) {
+  if (!have_prusaslicer()) GTEST_SKIP() << "prusa-slicer not installed";
+  const fs::path dir = test::temp_dir("pp_support");
+  // The dome 8 mm up on a 6 mm post: its underside needs support.
+  TriangleMesh part = test::dome_cut_by_box();
+  for (Vec3& v : part.vertices) v.z() += 8;
+  test::append(part, test::box({-3, -3, 0}, {3, 3, 8.5}));
+  const fs::path plan = prepared(dir, "perched", part), out = dir / "perched.gcode";
+  std::string log;
+  ASSERT_EQ(prusa("--export-gcode --first-layer-height 0.2 --support-material --brim-width 3 " +
+                      post_process_line(plan) + " -o " + out.string() + " " + plan.string(),
+                  &log),
+            0)
+      << log;
+  const std::string text = test::read_bytes(out);
+  EXPECT_NE(text.find(";TYPE:Support material\n"), std::string::npos);
+  const auto f = figures(out, dir / "perched.stl");
+  EXPECT_LE(f["top_surface_deviation"]["p95"].get<double>(), 0.02);
+  EXPECT_EQ(f["collisions"], 0);
+  // The engine route reads the same beads: the part's layer after a support-only one is the
+  // part's thickness, not the distance from the supports' (which once failed the gate with
+  // "a layer leaves the thickness limits").
+  const fs::path engine = dir / "engine.gcode";
+  const auto e =
+      test::run_cli("slice -q " + (dir / "perched.stl").string() +
+                    " --engine prusaslicer --set support_material=1 -o " + engine.string());
+  ASSERT_EQ(e.code, 0) << e.err;
+  EXPECT_NE(test::read_bytes(engine).find(";TYPE:Support material\n"), std::string::npos);
+  EXPECT_EQ(figures(engine, dir / "perched.stl")["collisions"], 0);
+}
+
+// The cube's extrusions inside its labels, without their E (the writer rounds E the same way,
+// but the point is where the nozzle goes).
+std::vector<std::string> lines_of_object(const std::string& text, const std::string& name) {
+  std::vector<std::string> out;
+  bool in = false;
+  std::stringstream ss(text);
+  for (std::string l; std::getline(ss, l);) {
+    if (l.rfind("; printing object " + name, 0) == 0) in = true;
+    if (l.rfind("; stop printing object " + name, 0) == 0) in = false;
+    if (!in || l.rfind("G1 X", 0) != 0 || l.find(" E") == std::string::npos) continue;
+    std::stringstream w(l.substr(0, l.find(" E")));
+    double x, y;
+    char c;
+    std::string g;
+    w >> g >> c >> x >> c >> y;
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%.3f %.3f", x, y);
+    out.push_back(buf);
+  }
+  return out;
+}
+
+// A plate of the prepared part and another object: with object labels the other one is left
+// as the slicer wrote it; without, post-process cannot tell them apart and says so.
+TEST(PostProcessRoute, OtherObjectsOnThePlateAreLeftAlone) {
+  if (!have_prusaslicer()) GTEST_SKIP() << "prusa-slicer not installed";
+  const fs::path dir = test::temp_dir("pp_plate");
+  const fs::path plan = prepared(dir, "dome", test::dome_cut_by_box());
+  ASSERT_TRUE(write_stl(dir / "cube.stl", test::box({0, 0, 0}, {15, 15, 6})));
+  const fs::path out = dir / "plate.gcode";
+  const std::string inputs = " --merge " + plan.string() + " " + (dir / "cube.stl").string();
+  ASSERT_EQ(prusa("--export-gcode --first-layer-height 0.2 --gcode-label-objects -o " +
+                  out.string() + inputs),
+            0);
+  const std::string before = test::read_bytes(out);
+  const auto r = test::run_cli("post-process --plan " + plan.string() + " " + out.string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("mapped plate.gcode onto the curved layers of dome"), std::string::npos);
+  EXPECT_NE(r.err.find("steepest extrusion 2"), std::string::npos) << r.err;  // 20-odd degrees
+  const std::string after = test::read_bytes(out);
+  const auto cube = lines_of_object(before, "cube");
+  EXPECT_GT(cube.size(), 100u);
+  EXPECT_EQ(lines_of_object(after, "cube"), cube);
+  EXPECT_NE(lines_of_object(after, "dome"), lines_of_object(before, "dome"));
+  EXPECT_EQ(figures(out, dir / "dome.stl")["collisions"], 0);
+  // Without labels.
+  ASSERT_EQ(prusa("--export-gcode --first-layer-height 0.2 -o " + out.string() + inputs), 0);
+  const auto u = test::run_cli("post-process --plan " + plan.string() + " " + out.string());
+  EXPECT_EQ(u.code, 2);
+  EXPECT_NE(u.err.find("switch on Label objects"), std::string::npos) << u.err;
+}
+
+TEST(PrepareCli, APartWithNothingToPlanIsRefused) {
+  const fs::path dir = test::temp_dir("prepare_refuse");
+  ASSERT_TRUE(write_stl(dir / "rib.stl", test::rib()));
+  const auto r =
+      test::run_cli("prepare " + (dir / "rib.stl").string() + " -o " + (dir / "rib.3mf").string());
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("nothing prints curved"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("curved shell over a planar core"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "rib.3mf"));
+  const auto bad = test::run_cli("prepare " + (dir / "rib.stl").string() + " -o " +
+                                 (dir / "rib.gcode").string());
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_NE(bad.err.find("prepare writes a .3mf"), std::string::npos) << bad.err;
+}
+
+}  // namespace
+}  // namespace nonplanar

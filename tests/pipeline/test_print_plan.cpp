@@ -1,0 +1,201 @@
+// The plan prepare writes and post-process reads (print_plan.hpp, field_io.hpp), and
+// post_process_gcode on G-code of the prepared part. The "slicer" here is our own planar
+// engine with a PrusaSlicer settings block appended, so these run without PrusaSlicer
+// (tests/cli/test_post_process.cpp runs the real one).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "nonplanar/check.hpp"
+#include "nonplanar/field_io.hpp"
+#include "nonplanar/print_plan.hpp"
+#include "support/solids.hpp"
+
+namespace nonplanar {
+namespace {
+
+struct Prepared {
+  TriangleMesh mesh;  // placed
+  PreparedPart part;
+};
+
+const Prepared& dome() {
+  static const Prepared p = [] {
+    Prepared d;
+    d.mesh = test::placed(test::dome_cut_by_box(), PrintConfig{});
+    auto part = prepare_part(d.mesh, make_job(PrintConfig{}), {});
+    EXPECT_TRUE(part) << part.error().message;
+    d.part = std::move(*part);
+    return d;
+  }();
+  return p;
+}
+
+// A slicer's planar G-code of `mesh` (ours), ending in the settings block PrusaSlicer writes.
+std::string sliced(const TriangleMesh& mesh, const std::string& block_extra = "") {
+  SliceJob job = make_job(PrintConfig{});
+  job.planar_only = true;
+  auto r = slice_model(mesh, job, {});
+  EXPECT_TRUE(r) << r.error().message;
+  return r->gcode +
+         "; prusaslicer_config = begin\n; layer_height = 0.2\n; first_layer_height = 0.2\n" +
+         block_extra + "; prusaslicer_config = end\n";
+}
+
+TriangleMesh moved(TriangleMesh m, const Vec3& by) {
+  for (Vec3& v : m.vertices) v += by;
+  return m;
+}
+
+TEST(PrintPlan, FieldReadsBackBitForBitAndShifted) {
+  const Prepared& d = dome();
+  ASSERT_EQ(d.part.stacks, 1u);
+  const LayerField& F = *d.part.field;
+  auto back = parse_layer_field_json(d.part.plan.field);
+  ASSERT_TRUE(back) << back.error().message;
+  auto shifted = parse_layer_field_json(d.part.plan.field, {7.5, -3.25});
+  ASSERT_TRUE(shifted);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> xy(80, 120), z(0, 12);
+  double worst_shift = 0, most_bent = 0;
+  for (int k = 0; k < 2000; ++k) {
+    const double x = xy(rng), y = xy(rng), h = z(rng);
+    const double t = F.T(x, y, h);
+    ASSERT_EQ((*back)->T(x, y, h), t);  // the very same doubles
+    ASSERT_EQ((*back)->z_at(x, y, t), F.z_at(x, y, t));
+    worst_shift = std::max(worst_shift, std::abs((*shifted)->T(x + 7.5, y - 3.25, h) - t));
+    most_bent = std::max(most_bent, std::abs(F.zeta(t) - h));
+  }
+  EXPECT_LT(worst_shift, 1e-9);
+  EXPECT_GT(most_bent, 0.5);  // the field does bend the layers there (a planar one would pass)
+}
+
+TEST(PrintPlan, PlanReadsBack) {
+  PrintPlan p = dome().part.plan;
+  p.object = "dome", p.model = "dome.stl";
+  p.toolhead.shape = {{2.0, {{{-3, -3}, {3, -3}, {3, 3}, {-3, 3}}}}};
+  p.toolhead.shape_name = "test head";
+  auto back = parse_plan_json(plan_json(p));
+  ASSERT_TRUE(back) << back.error().message;
+  EXPECT_EQ(back->object, "dome");
+  EXPECT_EQ(back->box.min, p.box.min);
+  EXPECT_EQ(back->box.max, p.box.max);
+  EXPECT_EQ(back->layer_height, p.layer_height);
+  EXPECT_EQ(back->first_layer_height, p.first_layer_height);
+  EXPECT_EQ(back->max_layer_height, p.max_layer_height);
+  EXPECT_EQ(back->max_angle_deg, p.max_angle_deg);
+  EXPECT_EQ(back->header, p.header);
+  ASSERT_EQ(back->toolhead.shape.size(), 1u);
+  EXPECT_EQ(back->toolhead.shape[0].polygons[0][2], Vec2(3, 3));
+  EXPECT_EQ(back->toolhead.describe(), p.toolhead.describe());
+}
+
+TEST(PrintPlan, BadPlansAreRefusedNotTrusted) {
+  const std::string good = plan_json(dome().part.plan);
+  EXPECT_EQ(parse_plan_json("{}").error().status, Status::parse_error);
+  std::string v2 = good;
+  v2.replace(v2.find("\"version\": 1"), 12, "\"version\": 2");
+  EXPECT_EQ(parse_plan_json(v2).error().status, Status::unsupported);
+  // Cut anywhere: an error, never a crash or a plan.
+  for (std::size_t cut : {std::size_t(10), good.size() / 3, good.size() / 2, good.size() - 5})
+    EXPECT_FALSE(parse_plan_json(good.substr(0, cut))) << cut;
+  // Sizes that disagree, values out of range.
+  auto field_err = [&](const std::string& from, const std::string& to) {
+    std::string f = dome().part.plan.field;
+    const auto at = f.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    f.replace(at, from.size(), to);
+    auto r = parse_layer_field_json(f);
+    return r ? std::string() : r.error().message;
+  };
+  EXPECT_NE(field_err("\"nx\":", "\"nx\":1").find("must hold"), std::string::npos);
+  EXPECT_NE(field_err("\"N\":", "\"N\":-").find("N"), std::string::npos);
+  EXPECT_NE(field_err("\"cell\":", "\"cell\":-").find("cell"), std::string::npos);
+  EXPECT_NE(field_err("\"layer_height\":", "\"layer_height\":1e9,\"x\":").find("layer heights"),
+            std::string::npos);
+}
+
+TEST(PostProcess, MapsTheSlicersGcodeAsTheEngineRouteDoes) {
+  const Prepared& d = dome();
+  auto out = post_process_gcode(sliced(d.part.normalized), d.part.plan, {});
+  ASSERT_TRUE(out) << out.error().message;
+  EXPECT_LT(out->moved.norm(), 1e-3);
+  EXPECT_GE(out->thickness_min, d.part.plan.min_layer_height - 1e-3);
+  EXPECT_LE(out->thickness_max, d.part.plan.max_layer_height + 1e-3);
+  EXPECT_GT(out->steepest_deg, 10);  // curved
+  EXPECT_EQ(out->gcode.rfind(kPostProcessedMark, 0), 0u);
+  auto moves = read_gcode_moves(out->gcode);
+  ASSERT_TRUE(moves);
+  auto f = check_print(*moves, &d.mesh, check_params(PrintConfig{}, 30), {});
+  ASSERT_TRUE(f);
+  EXPECT_LE(f->deviation_p95, 0.02);
+  EXPECT_EQ(f->collisions, 0u);
+  // Twice would lift it twice.
+  auto again = post_process_gcode(out->gcode, d.part.plan, {});
+  ASSERT_FALSE(again);
+  EXPECT_NE(again.error().message.find("already post-processed"), std::string::npos);
+}
+
+TEST(PostProcess, APartMovedOnThePlateIsFollowed) {
+  const Prepared& d = dome();
+  const Vec3 by(17.5, -9.25, 0);
+  auto out = post_process_gcode(sliced(moved(d.part.normalized, by)), d.part.plan, {});
+  ASSERT_TRUE(out) << out.error().message;
+  EXPECT_NEAR(out->moved.x(), by.x(), 0.02);
+  EXPECT_NEAR(out->moved.y(), by.y(), 0.02);
+  auto moves = read_gcode_moves(out->gcode);
+  ASSERT_TRUE(moves);
+  const TriangleMesh there = moved(d.mesh, by);
+  // check places the mesh at the bed's centre; give it the moved part's own placement.
+  CheckParams cp = check_params(PrintConfig{}, 30);
+  auto f = check_print(*moves, &there, cp, {});
+  ASSERT_TRUE(f);
+  EXPECT_LE(f->deviation_p95, 0.02);
+  EXPECT_EQ(f->collisions, 0u);
+}
+
+TEST(PostProcess, WhatThePlanNeedsIsRefusedByName) {
+  const Prepared& d = dome();
+  auto refused = [&](const std::string& gcode) {
+    auto r = post_process_gcode(gcode, d.part.plan, {});
+    EXPECT_FALSE(r);
+    return r ? std::string() : r.error().message;
+  };
+  // Scaled (or rotated: its box changes too).
+  TriangleMesh big = d.part.normalized;
+  const BoundingBox b = bounding_box(big);
+  for (Vec3& v : big.vertices) v.head<2>() = b.min.head<2>() + 1.15 * (v - b.min).head<2>();
+  EXPECT_NE(refused(sliced(big)).find("scaled or rotated"), std::string::npos);
+  // Another first layer.
+  PrintConfig thick;
+  thick.slice.first_layer_height = 0.3;
+  SliceJob job = make_job(thick);
+  job.planar_only = true;
+  auto r = slice_model(d.part.normalized, job, {});
+  ASSERT_TRUE(r);
+  EXPECT_NE(refused(r->gcode + "; prusaslicer_config = begin\n; layer_height = 0.2\n; "
+                               "prusaslicer_config = end\n")
+                .find("first_layer_height = 0.200"),
+            std::string::npos);
+  EXPECT_NE(refused(sliced(d.part.normalized, "; arc_fitting = emit_center\n")).find("arc_fitting"),
+            std::string::npos);
+  EXPECT_NE(refused(sliced(d.part.normalized, "; spiral_vase = 1\n")).find("spiral_vase"),
+            std::string::npos);
+  // Our own file has no settings block: not a slicer's.
+  SliceJob plain = make_job(PrintConfig{});
+  plain.planar_only = true;
+  EXPECT_NE(refused(slice_model(d.part.normalized, plain, {})->gcode).find("no settings block"),
+            std::string::npos);
+}
+
+TEST(PrintPlan, NothingCurvedIsNothingToPrepare) {
+  const TriangleMesh box = test::placed(test::box({0, 0, 0}, {20, 20, 10}), PrintConfig{});
+  auto part = prepare_part(box, make_job(PrintConfig{}), {});
+  ASSERT_FALSE(part);
+  EXPECT_EQ(part.error().status, Status::unsupported);
+  EXPECT_NE(part.error().message.find("nothing prints curved"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace nonplanar
