@@ -113,14 +113,18 @@ TEST(PostProcessRoute, FindsThePlanAsTheSlicerRunsIt) {
   // Object labels name the part; the G-code is named otherwise.
   const fs::path labelled = dir / "whatever.gcode";
   std::string log;
-  ASSERT_EQ(prusa("--export-gcode --first-layer-height 0.2 --gcode-label-objects --post-process '" +
+  ASSERT_EQ(prusa("--export-gcode --first-layer-height 0.2 --gcode-label-objects "
+                  "--use-relative-e-distances --post-process '" +
                       std::string(NONPLANAR_CLI) + " post-process' -o " + labelled.string() + " " +
                       plan.string(),
                   &log),
             0)
       << log;
-  EXPECT_LE(figures(labelled, dir / "dome.stl")["top_surface_deviation"]["p95"].get<double>(),
-            0.02);
+  const auto rel = figures(labelled, dir / "dome.stl");  // relative E, too
+  EXPECT_LE(rel["top_surface_deviation"]["p95"].get<double>(), 0.02);
+  EXPECT_NEAR(rel["volume_ratio"].get<double>(),
+              figures(pp, dir / "dome.stl")["volume_ratio"].get<double>(), 0.01);
+  EXPECT_NE(test::read_bytes(labelled).find("\nM83"), std::string::npos);
 }
 
 TEST(PostProcessRoute, RefusalsLeaveTheSlicersFileUntouched) {

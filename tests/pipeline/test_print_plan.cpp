@@ -178,6 +178,17 @@ TEST(PostProcess, WhatThePlanNeedsIsRefusedByName) {
                                "prusaslicer_config = end\n")
                 .find("first_layer_height = 0.200"),
             std::string::npos);
+  // Another layer height (the object's setting dropped, or variable layer height on).
+  PrintConfig thin;
+  thin.slice.layer_height = 0.15;
+  SliceJob tj = make_job(thin);
+  tj.planar_only = true;
+  auto t = slice_model(d.part.normalized, tj, {});
+  ASSERT_TRUE(t);
+  EXPECT_NE(refused(t->gcode + "; prusaslicer_config = begin\n; layer_height = 0.15\n; "
+                               "prusaslicer_config = end\n")
+                .find("layer 2 is 0.150 mm"),
+            std::string::npos);
   EXPECT_NE(refused(sliced(d.part.normalized, "; arc_fitting = emit_center\n")).find("arc_fitting"),
             std::string::npos);
   EXPECT_NE(refused(sliced(d.part.normalized, "; spiral_vase = 1\n")).find("spiral_vase"),
