@@ -72,8 +72,10 @@ bool zip64_sizes(std::string_view extra, std::uint64_t* usize, std::uint64_t* cs
   return *usize <= kMaxEntry && *csize <= kMaxEntry;
 }
 
-// Every entry, uncompressed, in central-directory order.
-std::optional<std::vector<Entry>> read_zip(std::string_view z) {
+// Every entry, uncompressed, in central-directory order; with `only`, that entry alone (the
+// others are neither inflated nor counted). At most `max_total` bytes uncompressed.
+std::optional<std::vector<Entry>> read_zip(std::string_view z, std::string_view only = {},
+                                           std::size_t max_total = kMaxEntry) {
   if (z.size() < 22) return std::nullopt;
   std::size_t eocd = std::string_view::npos;
   for (std::size_t i = z.size() - 22 + 1; i-- > 0 && z.size() - i <= 65557;)
@@ -109,10 +111,14 @@ std::optional<std::vector<Entry>> read_zip(std::string_view z) {
     if (local + 30 > z.size() || u32(z, static_cast<std::size_t>(local)) != 0x04034b50)
       return std::nullopt;
     Entry entry{std::string(z.substr(p + 46, n)), {}};
+    if (!only.empty() && entry.name != only) {
+      p += 46 + n + e + c;
+      continue;
+    }
     const std::size_t data = static_cast<std::size_t>(local) + 30 +
                              u16(z, static_cast<std::size_t>(local) + 26) +
                              u16(z, static_cast<std::size_t>(local) + 28);
-    if (data + csize > z.size() || (total += usize) > kMaxEntry) return std::nullopt;
+    if (data + csize > z.size() || (total += usize) > max_total) return std::nullopt;
     const std::string_view raw = z.substr(data, csize);
     if (method == 0 && csize == usize) {
       entry.data = std::string(raw);
@@ -202,9 +208,11 @@ std::string prune(const std::string& rels_name, const std::string& xml,
 
 }  // namespace
 
-std::optional<std::string> zip_entry(std::string_view zip, std::string_view name) {
+std::optional<std::string> zip_entry(std::string_view zip, std::string_view name,
+                                     std::size_t max_size) {
   if (!name.empty() && name[0] == '/') name.remove_prefix(1);
-  auto entries = read_zip(zip);
+  if (name.empty()) return std::nullopt;
+  auto entries = read_zip(zip, name, std::min(max_size, kMaxEntry));
   if (!entries) return std::nullopt;
   for (Entry& e : *entries)
     if (e.name == name) return std::move(e.data);

@@ -17,7 +17,9 @@ std::optional<std::string> drop_dangling_relationships(std::string_view zip,
                                                        std::vector<std::string>* dropped);
 
 /// The uncompressed bytes of entry `name` (leading '/' ignored); nullopt when the zip cannot
-/// be read (as above) or has no such entry.
-std::optional<std::string> zip_entry(std::string_view zip, std::string_view name);
+/// be read (as above), has no such entry, or it is larger than `max_size` bytes. Only that
+/// entry is inflated.
+std::optional<std::string> zip_entry(std::string_view zip, std::string_view name,
+                                     std::size_t max_size = std::size_t(1) << 30);
 
 }  // namespace nonplanar::io
