@@ -42,32 +42,6 @@ Expected<PrintPlan> load_plan(const fs::path& file) {
   return plan;
 }
 
-// The names the slicer's object labels give (PrusaSlicer 2.5's "; printing object NAME id:…",
-// M486 A"NAME …", Klipper's EXCLUDE_OBJECT_DEFINE NAME=…), without the id and copy.
-std::vector<std::string> labelled_objects(std::string_view g) {
-  std::vector<std::string> names;
-  auto add = [&](std::string n) {
-    for (const char* cut : {" id:", "_id_"})
-      if (auto at = n.find(cut); at != std::string::npos) n.resize(at);
-    while (!n.empty() && (n.back() == '"' || n.back() == '\'' || n.back() == ' ')) n.pop_back();
-    if (fs::path(n).has_extension()) n = fs::path(n).stem().string();
-    if (!n.empty() && std::find(names.begin(), names.end(), n) == names.end()) names.push_back(n);
-  };
-  for (const std::string_view head :
-       {std::string_view("; printing object "), std::string_view("M486 A"),
-        std::string_view("EXCLUDE_OBJECT_DEFINE NAME=")}) {
-    for (std::size_t at = g.find(head); at != std::string_view::npos && names.size() < 64;
-         at = g.find(head, at + 1)) {
-      if (at > 0 && g[at - 1] != '\n') continue;
-      std::size_t b = at + head.size();
-      if (b < g.size() && (g[b] == '"' || g[b] == '\'')) ++b;
-      const std::size_t e = std::min(g.find('\n', b), g.size());
-      add(std::string(g.substr(b, std::min<std::size_t>(e - b, 200))));
-    }
-  }
-  return names;
-}
-
 // The file's name without the slicer's temporary suffix (PrusaSlicer passes NAME.gcode.pp).
 fs::path final_name(const std::string& gcode) {
   if (const char* out = std::getenv("SLIC3R_PP_OUTPUT_NAME"); out && *out) return out;
@@ -80,7 +54,7 @@ fs::path final_name(const std::string& gcode) {
 // the final G-code or the file given. With labels, the plan's object must be one of them.
 Expected<PrintPlan> find_plan(const PostProcessOptions& o, std::string_view gcode) {
   if (!o.plan.empty()) return load_plan(o.plan);
-  const auto labels = labelled_objects(gcode);
+  const auto labels = gcode_object_names(gcode);
   std::vector<fs::path> dirs{final_name(o.gcode).parent_path(), fs::path(o.gcode).parent_path()};
   std::vector<std::string> stems = labels;
   stems.push_back(final_name(o.gcode).stem().string());

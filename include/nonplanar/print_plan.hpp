@@ -70,6 +70,11 @@ struct PostProcessed {
 Expected<PostProcessed> post_process_gcode(std::string_view gcode, const PrintPlan& plan,
                                            const Context& ctx);
 
+/// The objects a G-code file's labels name (PrusaSlicer's comments, M486, Klipper's
+/// EXCLUDE_OBJECT_*), without the slicer's id, copy and file extension ("dome id:0 copy 0" is
+/// "dome"), in order of first appearance; empty without labels.
+std::vector<std::string> gcode_object_names(std::string_view gcode);
+
 /// The first line post_process_gcode writes (how a file already post-processed is known).
 inline constexpr std::string_view kPostProcessedMark = "; post-processed by nonplanar";
 

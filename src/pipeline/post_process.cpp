@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
+#include <map>
 
 #include "nonplanar/config.hpp"
 #include "nonplanar/field_io.hpp"
@@ -81,21 +83,39 @@ std::string object_name(std::string n) {
   return n;
 }
 
-// What an object-label line says: the object that starts (its name), or that one ends.
+// Object labels as the slicers write them: PrusaSlicer 2.5's "; printing object NAME id:0
+// copy 0" / "; stop printing object", 2.6+'s firmware labels M486 S<id> A"NAME" / M486 S-1
+// (a later M486 S<id> starts that object again), Klipper's EXCLUDE_OBJECT_START NAME=… /
+// EXCLUDE_OBJECT_END.
 enum class Label { none, start, end };
-Label label_of(std::string_view raw, std::string* name) {
-  static const std::pair<std::string_view, Label> kHeads[] = {
-      {"; printing object ", Label::start},
-      {"; stop printing object", Label::end},
-      {"EXCLUDE_OBJECT_START NAME=", Label::start},
-      {"EXCLUDE_OBJECT_END", Label::end}};
-  for (const auto& [head, kind] : kHeads)
-    if (raw.substr(0, head.size()) == head) {
-      if (kind == Label::start) *name = object_name(std::string(raw.substr(head.size(), 200)));
-      return kind;
-    }
-  return Label::none;
-}
+class LabelReader {
+ public:
+  /// What line `raw` says; for a start, *name is the object's (object_name).
+  Label read(std::string_view raw, std::string* name) {
+    static const std::pair<std::string_view, Label> kHeads[] = {
+        {"; printing object ", Label::start},
+        {"; stop printing object", Label::end},
+        {"EXCLUDE_OBJECT_START NAME=", Label::start},
+        {"EXCLUDE_OBJECT_END", Label::end}};
+    for (const auto& [head, kind] : kHeads)
+      if (raw.substr(0, head.size()) == head) {
+        if (kind == Label::start) *name = object_name(std::string(raw.substr(head.size(), 200)));
+        return kind;
+      }
+    if (raw.substr(0, 6) != "M486 S") return Label::none;
+    const long id = std::strtol(std::string(raw.substr(6, 12)).c_str(), nullptr, 10);
+    if (id < 0) return Label::end;
+    if (const auto a = raw.find(" A"); a != std::string_view::npos)
+      names_[id] = object_name(std::string(raw.substr(a + 2, 200)));
+    const auto it = names_.find(id);
+    if (it == names_.end()) return Label::none;
+    *name = it->second;
+    return Label::start;
+  }
+
+ private:
+  std::map<long, std::string> names_;
+};
 
 // The part's outline in the slicer's words (PrusaSlicer's, OrcaSlicer's): supports and the
 // brim reach beyond it (PrusaSlicer 2.5's support base grows 5 mm past the part).
@@ -196,8 +216,9 @@ Expected<std::vector<char>> moves_of_part(const GcodeProgram& prog, const PrintP
   std::vector<char> ours(prog.moves.size(), 1);
   std::vector<std::string> names;
   std::string current, name;
+  LabelReader labels;
   for (const GcodeLine& l : prog.lines) {
-    const Label k = l.kind == GcodeLine::Kind::text ? label_of(l.raw, &name) : Label::none;
+    const Label k = l.kind == GcodeLine::Kind::text ? labels.read(l.raw, &name) : Label::none;
     if (k == Label::start) {
       current = name;
       if (std::find(names.begin(), names.end(), name) == names.end()) names.push_back(name);
@@ -218,6 +239,22 @@ Expected<std::vector<char>> moves_of_part(const GcodeProgram& prog, const PrintP
 }
 
 }  // namespace
+
+std::vector<std::string> gcode_object_names(std::string_view gcode) {
+  std::vector<std::string> names;
+  LabelReader labels;
+  std::string name;
+  for (std::size_t at = 0; at < gcode.size() && names.size() < 64;) {
+    const std::size_t end = std::min(gcode.find('\n', at), gcode.size());
+    const char c = gcode[at];
+    if ((c == ';' || c == 'M' || c == 'E') &&
+        labels.read(gcode.substr(at, end - at), &name) == Label::start &&
+        std::find(names.begin(), names.end(), name) == names.end())
+      names.push_back(name);
+    at = end + 1;
+  }
+  return names;
+}
 
 Expected<PostProcessed> post_process_gcode(std::string_view gcode, const PrintPlan& plan,
                                            const Context& ctx) {

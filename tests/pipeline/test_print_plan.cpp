@@ -200,6 +200,20 @@ TEST(PostProcess, WhatThePlanNeedsIsRefusedByName) {
             std::string::npos);
 }
 
+// The names object labels give, in the three ways slicers write them.
+TEST(PostProcess, ObjectLabelsNameTheParts) {
+  EXPECT_EQ(gcode_object_names("; printing object dome id:0 copy 0\nG1 X1\n; stop printing object "
+                               "dome id:0 copy 0\n; printing object cube.stl id:1 copy 0\n"),
+            (std::vector<std::string>{"dome", "cube"}));
+  EXPECT_EQ(gcode_object_names("M486 S0 A\"dome id:0 copy 0\"\nG1 X1\nM486 S-1\nM486 S1 A\"cube\"\n"
+                               "M486 S0\n"),
+            (std::vector<std::string>{"dome", "cube"}));
+  EXPECT_EQ(gcode_object_names("EXCLUDE_OBJECT_DEFINE NAME=dome_id_0_copy_0\n"
+                               "EXCLUDE_OBJECT_START NAME=dome_id_0_copy_0\nEXCLUDE_OBJECT_END\n"),
+            (std::vector<std::string>{"dome"}));
+  EXPECT_TRUE(gcode_object_names("G1 X1 ; printing object dome\n").empty());
+}
+
 TEST(PrintPlan, NothingCurvedIsNothingToPrepare) {
   const TriangleMesh box = test::placed(test::box({0, 0, 0}, {20, 20, 10}), PrintConfig{});
   auto part = prepare_part(box, make_job(PrintConfig{}), {});
