@@ -7,6 +7,7 @@
 
 #include "cli_common.hpp"
 #include "commands.hpp"
+#include "nonplanar/config.hpp"
 #include "nonplanar/print_plan.hpp"
 #include "nonplanar/print_time.hpp"
 
@@ -18,9 +19,37 @@ namespace fs = std::filesystem;
 struct PrepareOptions {
   MeshOptions mesh;
   ProfileOptions profile;
-  std::string output;
+  std::string output, check_with = "builtin", engine_path;
   double max_angle = 30.0;
 };
+
+// What checks the plan: the built-in engine, or PrusaSlicer with the same profile (its paths
+// are the ones the user's slicer will make; a patch they would push past a limit is then
+// left planar here rather than refused by post-process later).
+Expected<EngineParams> checker(const PrepareOptions& o) {
+  EngineParams e;
+  if (o.check_with == "builtin") return e;
+  if (o.check_with != "prusaslicer")
+    return Error{Status::invalid_argument,
+                 "--check-with: '" + o.check_with + "' is not builtin or prusaslicer"};
+  if (o.profile.config.size() > 1)
+    return Error{Status::invalid_argument,
+                 "--check-with prusaslicer takes one --config file (PrusaSlicer loads one)"};
+  e.engine = Engine::prusaslicer, e.path = o.engine_path;
+  if (!o.profile.config.empty()) e.config = o.profile.config[0];
+  PrintConfig scratch;
+  if (auto p = o.profile.presets.apply(scratch, &e.overrides); !p) return p.error();
+  std::vector<std::string> sets;
+  for (const auto& [key, value] : o.profile.keyed)
+    if (!value.empty()) sets.push_back(key + "=" + value);
+  sets.insert(sets.end(), o.profile.sets.begin(), o.profile.sets.end());
+  for (const std::string& kv : sets) {
+    auto applied = apply_setting(scratch, kv);
+    if (!applied) return applied.error();
+    if (!is_nonplanar_key(applied->key)) e.overrides.emplace_back(applied->key, applied->value);
+  }
+  return e;
+}
 
 // Where -o points: a folder (existing, or ending in '/') gets MODEL.3mf.
 std::string output_file(const PrepareOptions& o) {
@@ -76,7 +105,10 @@ int run(const PrepareOptions& o) {
   std::vector<std::string> inputs = o.profile.config;
   inputs.push_back(o.mesh.model);
   if (auto c = check_outputs(inputs, {out}); !c) return report_error(c.error());
+  auto engine = checker(o);
+  if (!engine) return report_error(engine.error());
   SliceJob job = make_job(*cfg, o.max_angle);
+  job.engine = *engine;
   if (!o.mesh.quiet)
     for (const Notice& n : job.notices) std::fprintf(stderr, "notice: %s\n", n.text.c_str());
   Context ctx = make_context(o.mesh.quiet);
@@ -134,6 +166,13 @@ void register_prepare(CLI::App& app, std::function<int()>* run_fn) {
   cmd->add_option("--max-angle", o->max_angle,
                   "Steepest surface printed non-planar, degrees (nozzle geometry)")
       ->capture_default_str();
+  cmd->add_option("--check-with", o->check_with,
+                  "What slices the plan to check it: builtin, or prusaslicer (the profile's own\n"
+                  "paths: a patch they would push past a limit stays planar here, instead of\n"
+                  "post-process refusing the file)")
+      ->capture_default_str();
+  cmd->add_option("--engine-path", o->engine_path,
+                  "PrusaSlicer's executable for --check-with (default: prusa-slicer on PATH)");
   *run_fn = nullptr;
   cmd->callback([o, run_fn] { *run_fn = [o] { return run(*o); }; });
 }

@@ -42,9 +42,10 @@ struct PreparedPart {
   std::size_t stacks = 0;                   ///< curved stacks in the plan
 };
 
-/// Inputs: the part placed on the bed, the job (its engine is ignored: the plan is checked by
-/// slicing it with the built-in engine, retries and all, as `slice` does). Output: the
-/// normalised part and the plan of the stacks that passed. A shell over a planar core takes
+/// Inputs: the part placed on the bed, the job (its engine slices the plan to check it,
+/// retries and all, as `slice` does: the built-in one, or PrusaSlicer with the user's profile,
+/// whose paths are the ones post-process will map). Output: the normalised part and the plan
+/// of the stacks that passed. A shell over a planar core takes
 /// two slicer runs, which one post-processing step cannot give, so shells are not planned.
 /// Errors: unsupported when nothing prints curved (the message says why), those of
 /// slice_model, cancelled.

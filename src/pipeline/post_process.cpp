@@ -16,7 +16,6 @@
 namespace nonplanar {
 
 Expected<PreparedPart> prepare_part(const TriangleMesh& placed, SliceJob job, const Context& ctx) {
-  job.engine = EngineParams{};  // checked with the built-in engine
   job.shells = false;
   auto r = slice_model(placed, job, ctx);
   if (!r) return r.error();
@@ -314,7 +313,10 @@ Expected<PostProcessed> post_process_gcode(std::string_view gcode, const PrintPl
   if (!ok) return ok.error();
   if (!*ok)
     return Error{Status::internal_error,
-                 "safety check: " + breach + "; the file is left as the slicer wrote it"};
+                 "safety check: " + breach +
+                     "; the file is left as the slicer wrote it (prepare again with "
+                     "--check-with prusaslicer and this profile: the patches its paths break "
+                     "then stay planar)"};
   PostProcessed out;
   out.gcode = with_print_stats(r.gcode, *cfg, &out.stats);
   out.moved = *moved;

@@ -235,6 +235,31 @@ TEST(PostProcessRoute, OtherObjectsOnThePlateAreLeftAlone) {
   EXPECT_NE(u.err.find("switch on Label objects"), std::string::npos) << u.err;
 }
 
+// The plan checked with PrusaSlicer's own paths for the user's presets (here the stock MK3S's),
+// then PrusaSlicer slices and post-process maps it.
+TEST(PostProcessRoute, APlanCheckedWithPrusaSlicersPaths) {
+  if (!have_prusaslicer()) GTEST_SKIP() << "prusa-slicer not installed";
+  const fs::path dir = test::temp_dir("pp_checked");
+  ASSERT_TRUE(write_stl(dir / "saddle.stl", test::saddle()));
+  const auto r = test::run_cli("prepare " + (dir / "saddle.stl").string() + " -o " +
+                               (dir / "saddle.3mf").string() +
+                               " --check-with prusaslicer --set first_layer_height=0.2");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("1 curved stack"), std::string::npos) << r.err;
+  const fs::path out = dir / "saddle.gcode";
+  ASSERT_EQ(
+      prusa("--export-gcode --first-layer-height 0.2 " + post_process_line(dir / "saddle.3mf") +
+            " -o " + out.string() + " " + (dir / "saddle.3mf").string()),
+      0);
+  const auto f = figures(out, dir / "saddle.stl");
+  EXPECT_LE(f["top_surface_deviation"]["p95"].get<double>(), 0.02);
+  EXPECT_EQ(f["collisions"], 0);
+  const auto bad = test::run_cli("prepare " + (dir / "saddle.stl").string() + " -o " +
+                                 (dir / "x.3mf").string() + " --check-with cura");
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_NE(bad.err.find("--check-with: 'cura' is not builtin or prusaslicer"), std::string::npos);
+}
+
 TEST(PrepareCli, APartWithNothingToPlanIsRefused) {
   const fs::path dir = test::temp_dir("prepare_refuse");
   ASSERT_TRUE(write_stl(dir / "rib.stl", test::rib()));
