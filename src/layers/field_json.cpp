@@ -1,8 +1,10 @@
 // The layer field as JSON (include/nonplanar/field_io.hpp, docs/plan-format.md). The bands'
-// top surfaces are one embedded nonplanar-surfaces document (docs/surface-format.md); the
-// rest is arrays of doubles, which nlohmann writes in their shortest round-trip form.
+// top surfaces are one embedded nonplanar-surfaces document (docs/surface-format.md); scalars
+// are written in their shortest round-trip form, arrays as base64 doubles.
 #include <cmath>
+#include <algorithm>
 #include <cstdint>
+#include <cstring>
 #include <nlohmann/json.hpp>
 
 #include "layers/banded_field.hpp"
@@ -24,17 +26,68 @@ namespace {
 constexpr std::int64_t kMaxNodes = 4'000'000;
 constexpr int kMaxLayers = 10'000;
 
+// Arrays of doubles as base64 of their IEEE-754 little-endian bytes: exact, and a raster of
+// a million nodes is one string to parse, not a million numbers (the bunny's plan: 15 MB of
+// text and 520 MB to read it back, before).
+constexpr char kB64[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+
+std::string doubles_b64(const double* v, std::size_t n) {
+  std::string bytes(n * 8, '\0'), out;
+  for (std::size_t i = 0; i < n; ++i) {
+    std::uint64_t u;
+    std::memcpy(&u, &v[i], 8);
+    for (int k = 0; k < 8; ++k) bytes[i * 8 + k] = static_cast<char>((u >> (8 * k)) & 0xff);
+  }
+  out.reserve((bytes.size() + 2) / 3 * 4);
+  for (std::size_t i = 0; i < bytes.size(); i += 3) {
+    const std::size_t m = std::min<std::size_t>(3, bytes.size() - i);
+    std::uint32_t w = 0;
+    for (std::size_t k = 0; k < 3; ++k)
+      w = (w << 8) | (k < m ? static_cast<unsigned char>(bytes[i + k]) : 0u);
+    for (std::size_t k = 0; k < 4; ++k)
+      out += k <= m ? kB64[(w >> (18 - 6 * k)) & 63] : '=';
+  }
+  return out;
+}
+
+std::vector<double> b64_doubles(const std::string& s, std::size_t n, const char* what) {
+  if (s.size() != (n * 8 + 2) / 3 * 4)
+    throw std::runtime_error(std::string(what) + " must hold " + std::to_string(n) + " numbers");
+  std::string bytes;
+  bytes.reserve(n * 8 + 2);
+  for (std::size_t i = 0; i < s.size(); i += 4) {
+    std::uint32_t w = 0;
+    for (std::size_t k = 0; k < 4; ++k) {
+      const char c = s[i + k];
+      const char* at = c == '=' ? nullptr : std::strchr(kB64, c);
+      if (c != '=' && (!at || c == '\0'))
+        throw std::runtime_error(std::string(what) + " is not base64");
+      w = (w << 6) | (at ? static_cast<std::uint32_t>(at - kB64) : 0u);
+    }
+    for (int k = 2; k >= 0; --k) bytes += static_cast<char>((w >> (8 * k)) & 0xff);
+  }
+  std::vector<double> out(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    std::uint64_t u = 0;
+    for (int k = 0; k < 8; ++k)
+      u |= std::uint64_t(static_cast<unsigned char>(bytes[i * 8 + k])) << (8 * k);
+    std::memcpy(&out[i], &u, 8);
+    if (!std::isfinite(out[i]))
+      throw std::runtime_error(std::string(what) + " holds a value that is not a number");
+  }
+  return out;
+}
+
 ordered_json raster(const Vec2& origin, double cell, int nx, int ny,
                     const std::vector<double>& values) {
   return {{"origin", {origin.x(), origin.y()}},
           {"cell", cell},
           {"nx", nx},
           {"ny", ny},
-          {"values", values}};
+          {"values", doubles_b64(values.data(), values.size())}};
 }
 
 ordered_json band_json(const Band& b, int top) {
-  std::vector<double> z(b.Z.data(), b.Z.data() + b.Z.size());  // column-major, as Eigen
   ordered_json j = {
       {"top", top},
       {"c", b.c},
@@ -43,7 +96,10 @@ ordered_json band_json(const Band& b, int top) {
       {"fade", b.fade},
       {"top_lo", b.top_lo},
       {"top_hi", b.top_hi},
-      {"control_heights", {{"rows", b.Z.rows()}, {"cols", b.Z.cols()}, {"values", z}}},
+      {"control_heights",  // column-major, as Eigen holds it
+                     {{"rows", b.Z.rows()},
+                      {"cols", b.Z.cols()},
+                      {"values", doubles_b64(b.Z.data(), static_cast<std::size_t>(b.Z.size()))}}},
       {"blend", raster(b.blend_origin, b.blend_cell, b.blend_nx, b.blend_ny, b.blend)}};
   if (!b.facets.empty()) {
     ordered_json f = raster(b.facets.origin, b.facets.cell, b.facets.nx, b.facets.ny, b.facets.h);
@@ -72,6 +128,7 @@ int count(const json& j, const char* key, std::int64_t hi) {
 }
 
 std::vector<double> numbers(const json& v, std::size_t n, const char* what) {
+  if (v.is_string()) return b64_doubles(v.get<std::string>(), n, what);
   if (!v.is_array() || v.size() != n)
     fail(std::string(what) + " must hold " + std::to_string(n) + " numbers");
   std::vector<double> out;

@@ -10,6 +10,7 @@
 #include "nonplanar/check.hpp"
 #include "nonplanar/field_io.hpp"
 #include "nonplanar/print_plan.hpp"
+#include "support/files.hpp"
 #include "support/solids.hpp"
 
 namespace nonplanar {
@@ -114,6 +115,25 @@ TEST(PrintPlan, BadPlansAreRefusedNotTrusted) {
   EXPECT_NE(field_err("\"cell\":", "\"cell\":-").find("cell"), std::string::npos);
   EXPECT_NE(field_err("\"layer_height\":", "\"layer_height\":1e9,\"x\":").find("layer heights"),
             std::string::npos);
+}
+
+// Arrays of doubles are written as base64 of their bytes; plain JSON arrays read the same.
+TEST(PrintPlan, Base64AndPlainArraysReadAlike) {
+  const std::string dir = NONPLANAR_TEST_DATA;
+  auto a = parse_plan_json(test::read_bytes(dir + "/plan_small.json"));
+  auto b = parse_plan_json(test::read_bytes(dir + "/plan_small_b64.json"));
+  ASSERT_TRUE(a) << a.error().message;
+  ASSERT_TRUE(b) << b.error().message;
+  auto fa = parse_layer_field_json(a->field), fb = parse_layer_field_json(b->field);
+  ASSERT_TRUE(fa) << fa.error().message;
+  ASSERT_TRUE(fb) << fb.error().message;
+  double bent = 0;
+  for (double x = 104; x <= 116; x += 0.7)
+    for (double z = 0.5; z < 6; z += 0.37) {
+      ASSERT_EQ((*fa)->T(x, x - 1, z), (*fb)->T(x, x - 1, z));
+      bent = std::max(bent, std::abs((*fa)->zeta((*fa)->T(x, x - 1, z)) - z));
+    }
+  EXPECT_GT(bent, 0.05);
 }
 
 TEST(PostProcess, MapsTheSlicersGcodeAsTheEngineRouteDoes) {
