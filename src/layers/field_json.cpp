@@ -1,8 +1,8 @@
 // The layer field as JSON (include/nonplanar/field_io.hpp, docs/plan-format.md). The bands'
 // top surfaces are one embedded nonplanar-surfaces document (docs/surface-format.md); scalars
 // are written in their shortest round-trip form, arrays as base64 doubles.
-#include <cmath>
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <nlohmann/json.hpp>
@@ -44,8 +44,7 @@ std::string doubles_b64(const double* v, std::size_t n) {
     std::uint32_t w = 0;
     for (std::size_t k = 0; k < 3; ++k)
       w = (w << 8) | (k < m ? static_cast<unsigned char>(bytes[i + k]) : 0u);
-    for (std::size_t k = 0; k < 4; ++k)
-      out += k <= m ? kB64[(w >> (18 - 6 * k)) & 63] : '=';
+    for (std::size_t k = 0; k < 4; ++k) out += k <= m ? kB64[(w >> (18 - 6 * k)) & 63] : '=';
   }
   return out;
 }
@@ -97,9 +96,9 @@ ordered_json band_json(const Band& b, int top) {
       {"top_lo", b.top_lo},
       {"top_hi", b.top_hi},
       {"control_heights",  // column-major, as Eigen holds it
-                     {{"rows", b.Z.rows()},
-                      {"cols", b.Z.cols()},
-                      {"values", doubles_b64(b.Z.data(), static_cast<std::size_t>(b.Z.size()))}}},
+       {{"rows", b.Z.rows()},
+        {"cols", b.Z.cols()},
+        {"values", doubles_b64(b.Z.data(), static_cast<std::size_t>(b.Z.size()))}}},
       {"blend", raster(b.blend_origin, b.blend_cell, b.blend_nx, b.blend_ny, b.blend)}};
   if (!b.facets.empty()) {
     ordered_json f = raster(b.facets.origin, b.facets.cell, b.facets.nx, b.facets.ny, b.facets.h);
