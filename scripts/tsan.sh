@@ -24,8 +24,4 @@ cmake --build "$build_dir" -j"$(nproc)"
 export OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1
 export TSAN_OPTIONS=${TSAN_OPTIONS:-halt_on_error=1:second_deadlock_stack=1:suppressions=$PWD/scripts/tsan.supp}
 cd "$build_dir"
-# StopsWhileALibraryCannotBeCancelled times a signal against lib3mf's reading, which runs
-# several times slower under TSan than the test's clock allows; it is about cancellation, not
-# threads, and runs in the other builds.
-ctest --output-on-failure -j"$(nproc)" --timeout 1800 -E 'StopsWhileALibraryCannotBeCancelled' \
-  ${1:+-R "$1"}
+ctest --output-on-failure -j"$(nproc)" --timeout 1800 ${1:+-R "$1"}
