@@ -170,8 +170,10 @@ Expected<LayerPlan> plan_layers(const TriangleMesh& mesh, const Analysis& analys
     if (it == built.end())
       it = built
                .emplace(pid, layers::build_stack(mesh, analysis.patches[pid], pid, fits[i].surface,
-                                                 columns, params, planar))
+                                                 columns, params, planar, 1.0, ctx))
                .first;
+    // A stack whose optimiser was stopped is not the plan's (nor the cache's).
+    if (ctx.cancelled()) return built.erase(it), Error{Status::cancelled, "cancelled"};
     layers::StackResult r = it->second;
     if (!r.failure.empty()) {
       plan.fallbacks.push_back({pid, r.failure});

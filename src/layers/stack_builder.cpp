@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "layers/printability_cost.hpp"
+#include "nurbs/solver_callbacks.hpp"
 
 namespace nonplanar::layers {
 namespace {
@@ -153,7 +154,7 @@ Figures measure(const StackGrid& g, const Eigen::MatrixXd& Z, const LayerParams&
 
 StackResult build_stack(const TriangleMesh& mesh, const Patch& patch, int patch_id,
                         const HeightField& top, const ColumnCaster& columns, const LayerParams& p,
-                        const PlanarLayers& planar, double initial_power) {
+                        const PlanarLayers& planar, double initial_power, const Context& ctx) {
   StackResult out;
   LayerStack& st = out.stack;
   st.patch = patch_id;
@@ -369,6 +370,8 @@ StackResult build_stack(const TriangleMesh& mesh, const Patch& patch, int patch_
     o.max_num_iterations = p.max_iterations;
     o.function_tolerance = 1e-7;
     o.logging_type = ceres::SILENT;
+    nurbs::SolverProgress stop(ctx, "", 0, 0, p.max_iterations);
+    o.callbacks.push_back(&stop);
     ceres::GradientProblemSolver::Summary sum;
     ceres::Solve(o, problem, x.data(), &sum);
     st.iterations = static_cast<int>(sum.iterations.size()) - 1;

@@ -2,6 +2,8 @@
 // measure the figures and decide whether it is printable.
 #pragma once
 
+#include "nonplanar/context.hpp"
+
 #include <string>
 
 #include "core/column_caster.hpp"
@@ -20,6 +22,6 @@ struct StackResult {
 StackResult build_stack(const TriangleMesh& mesh, const Patch& patch, int patch_id,
                         const HeightField& top, const ColumnCaster& columns,
                         const LayerParams& params, const PlanarLayers& planar,
-                        double initial_power = 1.0);
+                        double initial_power = 1.0, const Context& ctx = {});
 
 }  // namespace nonplanar::layers

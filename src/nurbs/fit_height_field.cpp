@@ -149,7 +149,8 @@ Expected<SurfaceFit> fit_height_field(const std::vector<Vec3>& samples, const Ve
   if (refine && params.nonlinear != NonlinearSolver::none && params.max_iterations > 0) {
     if (ctx.cancelled()) return Error{Status::cancelled, "cancelled"};
     NurbsSurface before = s;
-    out.nonlinear = fit_nonlinear(s, basis, uvz, lambda, params);
+    out.nonlinear = fit_nonlinear(s, basis, uvz, lambda, params, ctx);
+    if (ctx.cancelled()) return Error{Status::cancelled, "cancelled"};
     double mx2 = 0;
     const double rms2 = residuals(s, basis, uvz, &r, &mx2);
     // The solver minimises its own regularised cost; keep its result only if the data fit

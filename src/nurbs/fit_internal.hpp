@@ -5,6 +5,8 @@
 // the rational denominator; S_k = Σ N w z / D_k the surface height; r_k = S_k − z_k.
 #pragma once
 
+#include "nonplanar/context.hpp"
+
 #include <vector>
 
 #include "nonplanar/fit.hpp"
@@ -42,7 +44,8 @@ double fit_rational_linearised(NurbsSurface& s, const SampleBasis& b, const std:
 /// Nonlinear refinement over heights (and weights when params.free_weights) of the data
 /// residuals plus regularisation: second differences of the heights (weight `lambda`) and
 /// a pull of the weights towards 1.
+/// Reports progress as "fit" from 0.8 to 1 and stops early when ctx is cancelled.
 NonlinearReport fit_nonlinear(NurbsSurface& s, const SampleBasis& b, const std::vector<Vec3>& uvz,
-                              double lambda, const FitParams& params);
+                              double lambda, const FitParams& params, const Context& ctx);
 
 }  // namespace nonplanar::nurbs

@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <cmath>
 
 #include "core/column_caster.hpp"
@@ -183,6 +184,15 @@ TEST(Layers, OptimiserLowersTheCostOfAPoorStart) {
   const auto even = layers::build_stack(m, a.patches[0], 0, fit->surface, cols, lp, planar, 1.0);
   EXPECT_NEAR(even.stack.cost_after, even.stack.cost_before, 1e-9 * even.stack.cost_before);
   EXPECT_LE(r.stack.cost_after, even.stack.cost_before * 1.01);
+  // Cancelled (Ctrl-C, --max-time): the optimiser stops at its first iteration's end.
+  std::atomic<bool> stop{true};
+  Context cancelled;
+  cancelled.cancel_flag = &stop;
+  lp.optimizer = StackOptimizer::lbfgs;
+  const auto c =
+      layers::build_stack(m, a.patches[0], 0, fit->surface, cols, lp, planar, 3.0, cancelled);
+  EXPECT_GT(r.stack.iterations, 5);
+  EXPECT_LE(c.stack.iterations, 1);
 }
 
 TEST(Layers, SteepConeFallsBackToPlanarWithTheReason) {

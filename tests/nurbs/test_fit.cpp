@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <atomic>
+
 #include <cmath>
 #include <functional>
 
@@ -111,6 +113,32 @@ TEST(Fit, FreeWeightsBeatFixedWeightsOnASphericalCap) {
   ASSERT_TRUE(f2);
   EXPECT_LT(f2->rms_error, 0.8 * f0->rms_error);
   EXPECT_LE(f2->nonlinear.final_cost, f2->nonlinear.initial_cost);
+}
+
+// The nonlinear solvers report progress per iteration and stop when the run is cancelled
+// (#21 item 8): here the flag is raised by the first progress report from inside the solve
+// (the fit's stages before it report at most 0.8).
+TEST(Fit, NonlinearSolversStopWhenCancelled) {
+  const double R = 20;
+  const Fn cap = [R](double x, double y) { return std::sqrt(R * R - x * x - y * y); };
+  const Analytic a = analytic(cap, 7, 70);
+  for (const NonlinearSolver solver :
+       {NonlinearSolver::levenberg_marquardt, NonlinearSolver::gauss_newton_line_search}) {
+    FitParams p;
+    p.initial_spans = 1, p.max_control = 4, p.refine_only_if_needed = false;
+    p.nonlinear = solver;
+    std::atomic<bool> stop{false};
+    int reports_inside = 0;
+    Context ctx;
+    ctx.cancel_flag = &stop;
+    ctx.on_progress = [&](std::string_view stage, double f) {
+      if (stage == "fit" && f > 0.8 && f < 1.0) ++reports_inside, stop = true;
+    };
+    auto r = fit_patch(a.mesh, a.patch, p, ctx);
+    ASSERT_FALSE(r);
+    EXPECT_EQ(r.error().status, Status::cancelled);
+    EXPECT_EQ(reports_inside, 1);  // stopped at the next look
+  }
 }
 
 TEST(Fit, RejectsBadParameters) {
