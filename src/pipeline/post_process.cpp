@@ -208,9 +208,9 @@ Expected<Vec2> placement(const GcodeProgram& prog, const std::vector<char>& ours
   return Vec2(0.5 * (b.min + b.max).head<2>() - 0.5 * (plan.box.min + plan.box.max).head<2>());
 }
 
-// Which moves are the planned part's: with object labels in the file, all but those between
-// another object's start and end labels; without, all of them. Refused when labels name other
-// objects only.
+// Which moves are the planned part's: with object labels naming several objects, all but those
+// between another object's start and end labels; else all of them. Refused when the labels
+// name several objects and none is the plan's.
 Expected<std::vector<char>> moves_of_part(const GcodeProgram& prog, const PrintPlan& plan) {
   std::vector<char> ours(prog.moves.size(), 1);
   std::vector<std::string> names;
@@ -227,7 +227,8 @@ Expected<std::vector<char>> moves_of_part(const GcodeProgram& prog, const PrintP
     if (l.kind == GcodeLine::Kind::move && l.move >= 0)
       ours[l.move] = current.empty() || current == plan.object;
   }
-  if (names.empty()) return std::vector<char>(prog.moves.size(), 1);
+  // One object on the plate is the planned one, whatever the user renamed it to.
+  if (names.size() <= 1) return std::vector<char>(prog.moves.size(), 1);
   if (std::find(names.begin(), names.end(), plan.object) == names.end()) {
     std::string list;
     for (const std::string& n : names) list += (list.empty() ? "" : ", ") + n;

@@ -232,6 +232,25 @@ TEST(PostProcess, ObjectLabelsNameTheParts) {
                                "EXCLUDE_OBJECT_START NAME=dome_id_0_copy_0\nEXCLUDE_OBJECT_END\n"),
             (std::vector<std::string>{"dome"}));
   EXPECT_TRUE(gcode_object_names("G1 X1 ; printing object dome\n").empty());
+  // post-process: one labelled object is the plan's whatever its name; of several, one must be.
+  const Prepared& d = dome();
+  const std::string g = sliced(d.part.normalized);
+  const auto at = g.find(";LAYER_CHANGE");
+  const std::string renamed =
+      g.substr(0, at) + "; printing object my dome id:0 copy 0\n" + g.substr(at);
+  EXPECT_TRUE(post_process_gcode(renamed, d.part.plan, {}));
+  const std::string two = g.substr(0, at) +
+                          "; printing object cube id:1 copy 0\n; stop printing "
+                          "object cube id:1 copy 0\n; printing object my dome id:0 copy 0\n" +
+                          g.substr(at);
+  PrintPlan named = d.part.plan;
+  named.object = "dome";
+  auto r = post_process_gcode(two, named, {});
+  ASSERT_FALSE(r);
+  EXPECT_NE(r.error().message.find("the plate's objects are cube, my dome; none is dome, the "
+                                   "plan's"),
+            std::string::npos)
+      << r.error().message;
 }
 
 TEST(PrintPlan, NothingCurvedIsNothingToPrepare) {
