@@ -249,6 +249,12 @@ struct Checked {
 Expected<Checked> checked_placement(std::string_view gcode, const std::string& block,
                                     const PrintPlan& plan) {
   const GcodeProgram prog = read_gcode_program(gcode);
+  for (const GcodeProblem& q : prog.problems)
+    if (q.why.rfind("arc move", 0) == 0)
+      return refuse("line " + std::to_string(q.line) +
+                    " is an arc (G2/G3): switch arc fitting off (Print Settings > Advanced > "
+                    "Arc fitting; OrcaSlicer: Process > Quality), arcs cannot follow curved "
+                    "layers");
   auto ours = moves_of_part(prog, plan);
   if (!ours) return ours.error();
   auto moved = placement(prog, *ours, plan);

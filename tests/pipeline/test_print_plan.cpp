@@ -213,6 +213,10 @@ TEST(PostProcess, WhatThePlanNeedsIsRefusedByName) {
             std::string::npos);
   EXPECT_NE(refused(sliced(d.part.normalized, "; spiral_vase = 1\n")).find("spiral_vase"),
             std::string::npos);
+  // An arc in the print (a slicer with arc fitting on), named with the setting to change.
+  std::string arcs = sliced(d.part.normalized);
+  arcs.insert(arcs.find("\n", arcs.find(";TYPE:Perimeter")) + 1, "G2 X100 Y100 I1 J0 E0.1\n");
+  EXPECT_NE(refused(arcs).find("is an arc (G2/G3): switch arc fitting off"), std::string::npos);
   // Our own file has no settings block: not a slicer's.
   SliceJob plain = make_job(PrintConfig{});
   plain.planar_only = true;
