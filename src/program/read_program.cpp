@@ -163,6 +163,7 @@ void Reader::comment(std::string_view c, std::size_t semi, GcodeLine& item, bool
     ++layer_;
     p_.layer_height.push_back(h_);
     p_.layer_z.push_back(pos_.z() + h_);
+    bead_h_ = h_;  // a layer without its own ;HEIGHT: keeps the last layer's, not a bead's
     layer_header_ = true;
   }
   // The layer's thickness is the ;HEIGHT: of its header; later ones are a bead's (a bridge's

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <random>
 
 #include "nonplanar/check.hpp"
@@ -33,15 +34,24 @@ const Prepared& dome() {
   return p;
 }
 
-// A slicer's planar G-code of `mesh` (ours), ending in the settings block PrusaSlicer writes.
-std::string sliced(const TriangleMesh& mesh, const std::string& block_extra = "") {
-  SliceJob job = make_job(PrintConfig{});
+// Our planar engine's G-code of `mesh` with the settings `c` (no settings block).
+std::string planar_gcode(const TriangleMesh& mesh, const PrintConfig& c = {}) {
+  SliceJob job = make_job(c);
   job.planar_only = true;
   auto r = slice_model(mesh, job, {});
   EXPECT_TRUE(r) << r.error().message;
-  return r->gcode +
-         "; prusaslicer_config = begin\n; layer_height = 0.2\n; first_layer_height = 0.2\n" +
-         block_extra + "; prusaslicer_config = end\n";
+  return r ? r->gcode : std::string();
+}
+
+// A slicer's planar G-code of `mesh` (ours), ending in the settings block PrusaSlicer writes:
+// c's layer heights, then `block_extra`.
+std::string sliced(const TriangleMesh& mesh, const std::string& block_extra = "",
+                   const PrintConfig& c = {}) {
+  char heights[120];
+  std::snprintf(heights, sizeof heights, "; layer_height = %g\n; first_layer_height = %g\n",
+                c.slice.layer_height, c.slice.first_layer_height);
+  return planar_gcode(mesh, c) + "; prusaslicer_config = begin\n" + heights + block_extra +
+         "; prusaslicer_config = end\n";
 }
 
 TriangleMesh moved(TriangleMesh m, const Vec3& by) {
@@ -187,27 +197,14 @@ TEST(PostProcess, WhatThePlanNeedsIsRefusedByName) {
   const BoundingBox b = bounding_box(big);
   for (Vec3& v : big.vertices) v.head<2>() = b.min.head<2>() + 1.15 * (v - b.min).head<2>();
   EXPECT_NE(refused(sliced(big)).find("scaled or rotated"), std::string::npos);
-  // Another first layer.
-  PrintConfig thick;
+  // Another first layer; another layer height (the object's setting dropped, or variable
+  // layer height on).
+  PrintConfig thick, thin;
   thick.slice.first_layer_height = 0.3;
-  SliceJob job = make_job(thick);
-  job.planar_only = true;
-  auto r = slice_model(d.part.normalized, job, {});
-  ASSERT_TRUE(r);
-  EXPECT_NE(refused(r->gcode + "; prusaslicer_config = begin\n; layer_height = 0.2\n; "
-                               "prusaslicer_config = end\n")
-                .find("first_layer_height = 0.200"),
-            std::string::npos);
-  // Another layer height (the object's setting dropped, or variable layer height on).
-  PrintConfig thin;
   thin.slice.layer_height = 0.15;
-  SliceJob tj = make_job(thin);
-  tj.planar_only = true;
-  auto t = slice_model(d.part.normalized, tj, {});
-  ASSERT_TRUE(t);
-  EXPECT_NE(refused(t->gcode + "; prusaslicer_config = begin\n; layer_height = 0.15\n; "
-                               "prusaslicer_config = end\n")
-                .find("layer 2 is 0.150 mm"),
+  EXPECT_NE(refused(sliced(d.part.normalized, "", thick)).find("first_layer_height = 0.200"),
+            std::string::npos);
+  EXPECT_NE(refused(sliced(d.part.normalized, "", thin)).find("layer 2 is 0.150 mm"),
             std::string::npos);
   EXPECT_NE(refused(sliced(d.part.normalized, "; arc_fitting = emit_center\n")).find("arc_fitting"),
             std::string::npos);
@@ -218,10 +215,7 @@ TEST(PostProcess, WhatThePlanNeedsIsRefusedByName) {
   arcs.insert(arcs.find("\n", arcs.find(";TYPE:Perimeter")) + 1, "G2 X100 Y100 I1 J0 E0.1\n");
   EXPECT_NE(refused(arcs).find("is an arc (G2/G3): switch arc fitting off"), std::string::npos);
   // Our own file has no settings block: not a slicer's.
-  SliceJob plain = make_job(PrintConfig{});
-  plain.planar_only = true;
-  EXPECT_NE(refused(slice_model(d.part.normalized, plain, {})->gcode).find("no settings block"),
-            std::string::npos);
+  EXPECT_NE(refused(planar_gcode(d.part.normalized)).find("no settings block"), std::string::npos);
 }
 
 // The names object labels give, in the three ways slicers write them.
