@@ -1,13 +1,13 @@
 #!/usr/bin/env bash
 # Quick start, part 1: build, then slice the bundled example with non-planar top layers,
-# draw a cross-section of its layers, and print the quality figures (beside PrusaSlicer's
-# planar slicing of the same model when prusa-slicer is installed).
+# write its 3D preview page and a cross-section of its layers, and print the quality figures
+# (beside PrusaSlicer's planar slicing of the same model when prusa-slicer is installed).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/build.sh
 model=examples/wave_roof.stl
 mkdir -p out
-./build/nonplanar slice "$model" -o out/wave_roof.gcode
+./build/nonplanar slice "$model" -o out/wave_roof.gcode --preview
 ./build/nonplanar layers -q "$model" --section out/wave_roof_section.svg --at y=110 >/dev/null
 echo "cross-section of the layers: out/wave_roof_section.svg"
 echo

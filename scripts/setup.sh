@@ -3,12 +3,14 @@
 # Idempotent: packages already present are skipped, and apt is not touched at all when
 # nothing is missing. Run as root on Debian 12 (uses sudo when not root and available).
 #
-# Usage: scripts/setup.sh [--with-prusaslicer] [--with-clang]
+# Usage: scripts/setup.sh [--with-prusaslicer] [--with-clang] [--with-browser]
 #   --with-prusaslicer  also install prusa-slicer (planar reference in benchmarks, the
 #                       external engine and its tests); large, so only the test suite,
 #                       benchmarks and engine paths ask for it.
 #   --with-clang        also install clang-14 and its sanitizer/libFuzzer runtimes
 #                       (scripts/sanitize.sh, fuzz/run.sh).
+#   --with-browser      also install chromium: the preview tests open the page headless
+#                       (software WebGL) and read its screenshot back.
 set -euo pipefail
 
 pkgs=(
@@ -22,6 +24,7 @@ for arg in "$@"; do
   case "$arg" in
     --with-prusaslicer) pkgs+=(prusa-slicer) ;;
     --with-clang) pkgs+=(clang-14 libclang-rt-14-dev) ;;
+    --with-browser) pkgs+=(chromium) ;;
     *) echo "error: setup: unknown option '$arg'" >&2; exit 2 ;;
   esac
 done

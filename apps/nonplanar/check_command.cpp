@@ -21,20 +21,6 @@ struct CheckOptions {
   bool json = false;
 };
 
-// The printer a file was sliced for, from its own settings block (PrusaSlicer's, and so our
-// engine route's): its bed centre is where the part was placed. Defaults when it has none or
-// the block does not read (a notice says why).
-PrintConfig file_config(const std::string& file, std::string_view gcode, bool quiet) {
-  const std::string block = gcode_config_block(gcode);
-  if (block.empty()) return {};
-  auto c = parse_ini_config(block);
-  if (c) return std::move(*c);
-  if (!quiet)
-    std::fprintf(stderr, "notice: %s: its settings block is not used: %s\n", file.c_str(),
-                 c.error().message.c_str());
-  return {};
-}
-
 int run(const CheckOptions& o) {
   if (auto a = check_max_angle(o.max_angle); !a) return report_error(a.error());
   auto bytes = core::read_file_bytes(o.gcode, 2ull << 30);

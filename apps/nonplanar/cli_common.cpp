@@ -332,4 +332,15 @@ void finish_progress() {
   g_progress_drawn = false;
 }
 
+PrintConfig file_config(const std::string& file, std::string_view gcode, bool quiet) {
+  const std::string block = gcode_config_block(gcode);
+  if (block.empty()) return {};
+  auto c = parse_ini_config(block);
+  if (c) return std::move(*c);
+  if (!quiet)
+    std::fprintf(stderr, "notice: %s: its settings block is not used: %s\n", file.c_str(),
+                 c.error().message.c_str());
+  return {};
+}
+
 }  // namespace nonplanar::cli

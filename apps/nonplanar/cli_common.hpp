@@ -120,4 +120,9 @@ Context make_context(bool quiet);
 /// Clears the progress line, if one was drawn.
 void finish_progress();
 
+/// The printer a G-code file was sliced for, from its own settings block (PrusaSlicer's, and
+/// so our engine route's): its bed centre is where the part was placed. Defaults when it has
+/// none or the block does not read (a notice says why, unless quiet).
+PrintConfig file_config(const std::string& file, std::string_view gcode, bool quiet);
+
 }  // namespace nonplanar::cli

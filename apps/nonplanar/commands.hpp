@@ -20,5 +20,7 @@ void register_check(CLI::App& app, std::function<int()>* run);
 void register_prepare(CLI::App& app, std::function<int()>* run);
 /// Adds "post-process".
 void register_post_process(CLI::App& app, std::function<int()>* run);
+/// Adds "preview".
+void register_preview(CLI::App& app, std::function<int()>* run);
 
 }  // namespace nonplanar::cli

@@ -26,6 +26,7 @@ int main(int argc, char** argv) {
   register_check(app, &run);
   register_prepare(app, &run);
   register_post_process(app, &run);
+  register_preview(app, &run);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -8,6 +8,7 @@
 #include "nonplanar/gcode.hpp"
 #include "nonplanar/pipeline.hpp"
 #include "nonplanar/unsupported_keys.hpp"
+#include "preview_command.hpp"
 
 namespace nonplanar::cli {
 namespace {
@@ -30,7 +31,7 @@ struct SliceOptions {
   std::string output;
   std::vector<std::string> config;  ///< profiles, each over the ones before
   std::string engine = "builtin", engine_path, engine_config, engine_filaments;
-  bool planar = false;
+  bool planar = false, preview = false;
   double max_angle = 30.0;
   // Overrides, applied by key after the profile, in this order.
   std::vector<std::pair<std::string, std::string*>> named;  // points into values
@@ -86,7 +87,8 @@ int run(const SliceOptions& o) {
   if (!output) return report_error(output.error());
   std::vector<std::string> inputs = o.config;
   inputs.insert(inputs.end(), {o.mesh.model, o.engine_config, o.engine_filaments, o.engine_path});
-  if (auto c = check_outputs(inputs, {*output}); !c) return report_error(c.error());
+  const std::string preview = o.preview ? preview_path_for(*output) : std::string();
+  if (auto c = check_outputs(inputs, {*output, preview}); !c) return report_error(c.error());
   if (!o.mesh.quiet) {
     // What the built-in engine substitutes (a fill pattern it lacks) and leaves out: another
     // engine does both itself.
@@ -126,6 +128,14 @@ int run(const SliceOptions& o) {
     return finish_progress(), report_error(e);
   }
   auto w = write_gcode_text(*output, result->gcode, ctx);
+  if (w && o.preview) {
+    // The gate found 0 collisions; the page has the placed mesh and the file's own layers.
+    PreviewSummary summary;
+    summary.collisions = 0;
+    summary.max_angle_deg = job.analysis.max_angle_deg;
+    PreviewInput in{*output, result->gcode, preview, &loaded->mesh, {}};
+    if (auto p = write_preview(in, cfg, summary); !p) w = p.error();
+  }
   finish_progress();
   if (!w) return report_error(w.error());
   report_warnings(o.mesh.model, *loaded, o.mesh.quiet);
@@ -145,6 +155,7 @@ int run(const SliceOptions& o) {
                  result->thickness_max, result->steepest_deg,
                  format_duration(result->stats.seconds).c_str(),
                  result->stats.filament_mm / 1000.0);
+    if (o.preview) std::fprintf(stderr, "wrote %s (open it in a browser)\n", preview.c_str());
     for (const auto& n : result->notices)  // the last word, after what was written
       if (n.kind == Notice::Kind::summary) std::fprintf(stderr, "%s\n", n.text.c_str());
   }
@@ -173,6 +184,9 @@ void register_slice(CLI::App& app, std::function<int()>* run_fn) {
                   "inherits resolved; docs/orcaslicer-profiles.md) or a flat .json; repeat it for\n"
                   "a printer, a print and a filament file, each over the ones before");
   cmd->add_flag("--planar", o->planar, "Planar layers only (the ordinary slicing engine)");
+  cmd->add_flag("--preview", o->preview,
+                "Also write OUTPUT.html: the toolpaths in 3D with a slider over the layers "
+                "(see 'preview')");
   cmd->add_option("--engine", o->engine,
                   "Planar engine for the normalised mesh: builtin, prusaslicer (PrusaSlicer 2.5+\n"
                   "command line; a shell over a planar core takes two runs, stitched) or\n"

@@ -40,6 +40,12 @@ struct PrintStats {
   double seconds = 0, filament_mm = 0, filament_cm3 = 0, filament_g = 0;
 };
 
+/// A program's statistics (read_gcode_program's reading): the time is estimate_print_time's
+/// with machine_limits(c), whose per-line times go to `time` when given; filament is the net
+/// E of every move; grams need the profile's filament_density.
+PrintStats print_stats(const GcodeProgram& program, const PrintConfig& c,
+                       PrintTime* time = nullptr);
+
 /// The program with its statistics recomputed from its own moves, whoever wrote it: the
 /// footer PrusaSlicer writes (filament used in mm, cm³ and g, filament cost when the profile
 /// prices it, "; estimated printing time (normal mode) = 1h 2m 3s"; any such lines already

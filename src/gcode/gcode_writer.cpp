@@ -414,6 +414,9 @@ Expected<std::string> make_gcode(const std::vector<LayerToolpaths>& layers, cons
   em.line(g.relative_e ? "M83 ; relative E" : "M82 ; absolute E");
   const gcode::ObjectLabels labels = gcode::object_labels(c);
   em.raw(labels.define(layers));
+  // The start and end G-code are "Custom" moves, as PrusaSlicer marks them: its viewer shows
+  // the purge line so, and the reader's print ends at the last one.
+  em.line(";TYPE:Custom");
   em.raw(start);
   em.raw(blocks->start_filament);
   em.line("G92 E0");
@@ -467,6 +470,7 @@ Expected<std::string> make_gcode(const std::vector<LayerToolpaths>& layers, cons
   }
   if (em.fault) return *em.fault;
   if (em.format_fault()) return *em.format_fault();
+  em.line(";TYPE:Custom");
   em.fan(0);
   em.raw(blocks->end_filament);
   em.raw(blocks->end);

@@ -67,18 +67,26 @@ MachineLimits machine_limits(const PrintConfig& c) {
   return m;
 }
 
-std::string with_print_stats(std::string_view gcode, const PrintConfig& c, PrintStats* stats) {
-  const GcodeProgram program = read_gcode_program(gcode);
-  const PrintTime t = estimate_print_time(program, machine_limits(c));
+PrintStats print_stats(const GcodeProgram& program, const PrintConfig& c, PrintTime* time) {
+  PrintTime t = estimate_print_time(program, machine_limits(c));
   double filament = 0;  // net: a retraction and its restore cancel
   for (const GcodeMove& m : program.moves) filament += m.de;
   filament = std::max(0.0, filament);
   const double d = c.gcode.filament_diameter;
   const double cm3 = filament * M_PI * 0.25 * d * d / 1000.0;
   const double grams = cm3 * first_number(c, "filament_density").value_or(0);
+  PrintStats s{t.total, filament, cm3, grams};
+  if (time) *time = std::move(t);
+  return s;
+}
+
+std::string with_print_stats(std::string_view gcode, const PrintConfig& c, PrintStats* stats) {
+  const GcodeProgram program = read_gcode_program(gcode);
+  PrintTime t;
+  const PrintStats s = print_stats(program, c, &t);
+  const double filament = s.filament_mm, cm3 = s.filament_cm3, grams = s.filament_g;
   const auto cost_per_kg = first_number(c, "filament_cost");
   const bool progress = first_number(c, "remaining_times").value_or(0) != 0;
-  PrintStats s{t.total, filament, cm3, grams};
   if (stats) *stats = s;
 
   char buf[512];

@@ -7,6 +7,7 @@
 #include <cstring>
 #include <nlohmann/json.hpp>
 
+#include "core/base64.hpp"
 #include "layers/banded_field.hpp"
 #include "nonplanar/field_io.hpp"
 #include "nonplanar/surface_io.hpp"
@@ -29,24 +30,14 @@ constexpr int kMaxLayers = 10'000;
 // Arrays of doubles as base64 of their IEEE-754 little-endian bytes: exact, and a raster of
 // a million nodes is one string to parse, not a million numbers (the bunny's plan: 15 MB of
 // text and 520 MB to read it back, before).
-constexpr char kB64[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-
 std::string doubles_b64(const double* v, std::size_t n) {
-  std::string bytes(n * 8, '\0'), out;
+  std::string bytes(n * 8, '\0');
   for (std::size_t i = 0; i < n; ++i) {
     std::uint64_t u;
     std::memcpy(&u, &v[i], 8);
     for (int k = 0; k < 8; ++k) bytes[i * 8 + k] = static_cast<char>((u >> (8 * k)) & 0xff);
   }
-  out.reserve((bytes.size() + 2) / 3 * 4);
-  for (std::size_t i = 0; i < bytes.size(); i += 3) {
-    const std::size_t m = std::min<std::size_t>(3, bytes.size() - i);
-    std::uint32_t w = 0;
-    for (std::size_t k = 0; k < 3; ++k)
-      w = (w << 8) | (k < m ? static_cast<unsigned char>(bytes[i + k]) : 0u);
-    for (std::size_t k = 0; k < 4; ++k) out += k <= m ? kB64[(w >> (18 - 6 * k)) & 63] : '=';
-  }
-  return out;
+  return core::base64_encode(bytes);
 }
 
 std::vector<double> b64_doubles(const std::string& s, std::size_t n, const char* what) {
@@ -58,10 +49,10 @@ std::vector<double> b64_doubles(const std::string& s, std::size_t n, const char*
     std::uint32_t w = 0;
     for (std::size_t k = 0; k < 4; ++k) {
       const char c = s[i + k];
-      const char* at = c == '=' ? nullptr : std::strchr(kB64, c);
+      const char* at = c == '=' ? nullptr : std::strchr(core::kBase64Alphabet, c);
       if (c != '=' && (!at || c == '\0'))
         throw std::runtime_error(std::string(what) + " is not base64");
-      w = (w << 6) | (at ? static_cast<std::uint32_t>(at - kB64) : 0u);
+      w = (w << 6) | (at ? static_cast<std::uint32_t>(at - core::kBase64Alphabet) : 0u);
     }
     for (int k = 2; k >= 0; --k) bytes += static_cast<char>((w >> (8 * k)) & 0xff);
   }
