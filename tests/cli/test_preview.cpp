@@ -93,6 +93,13 @@ TEST(Preview, TheBrowserShowsTheCurvedLayersAndCountsOurLayers) {
   // The slider's first position from the address: one layer.
   const std::string one = open_in_chromium(dir / "roof.html", "#layers=3-3", nullptr);
   EXPECT_EQ(body_number(one, "layer-shown"), 3);
+  // While the view moves a large file is drawn from the lighter copy: made here above 10 000
+  // segments, it merges runs of touching segments (3 to 10 here) and still draws the part.
+  const long segments = body_number(dom, "drawn-segments");
+  const std::string moving = open_in_chromium(dir / "roof.html", "#lod=10000&moving=1", nullptr);
+  EXPECT_LT(body_number(moving, "drawn-segments"), segments * 2 / 3);
+  EXPECT_GT(body_number(moving, "drawn-segments"), segments / 20);
+  EXPECT_GT(body_number(moving, "drawn-pixels"), body_number(dom, "drawn-pixels") / 2);
 }
 
 TEST(Preview, WithTheMeshItShowsChecksFigures) {
