@@ -33,34 +33,59 @@ struct Pt {
   bool sparse = false;  ///< sparse infill (";TYPE:Internal infill")
 };
 
-// Extrusion points binned on an XY grid of kNear cells: one array sorted by (cell, layer),
-// with the range of every (cell, layer) for the plane fits, which read one layer, and of
-// every cell for "the highest layer here". (One list per cell made every plane fit walk all
-// layers above that cell, quadratic in the part's height; a vector per (cell, layer) spent
-// most of the time in the allocator.)
+bool counts(const PrintMove& m) {
+  return m.extruding && m.layer >= 0 && m.type != "Skirt/Brim";
+}
+
+// Calls f on every extrusion point: every 0.2 mm along each counted move (the coverage test
+// allows half of that beyond half a line width), in print order.
+template <class F>
+void for_each_sample(const std::vector<PrintMove>& moves, F&& f) {
+  for (const PrintMove& m : moves) {
+    if (!counts(m)) continue;
+    const int n = std::max(1, static_cast<int>(std::ceil((m.to - m.from).norm() / 0.2)));
+    const bool sparse = m.type == "Internal infill";
+    for (int k = 1; k <= n; ++k)
+      f(Pt{m.from + (m.to - m.from) * (static_cast<double>(k) / n), m.layer, sparse});
+  }
+}
+
+// Extrusion points binned on an XY grid of kNear cells, dense over the points' box: the
+// points of a cell are contiguous, in print order, so sorted by layer (layers only grow
+// along a file), and each cell lists its runs of one layer for the plane fits, which read
+// one layer. "The highest layer here" scans a cell's points from its end. (One list per cell
+// made every plane fit walk all layers above that cell, quadratic in the part's height; a
+// vector per (cell, layer) spent most of the time in the allocator; a hash map of (cell,
+// layer) ranges spent 44 % of the bunny's check in its lookups and 2.4 GB with the sort's
+// copies.)
 class PointGrid {
  public:
-  explicit PointGrid(std::vector<Pt> pts) : pts_(std::move(pts)) {
-    std::vector<std::pair<Key, std::size_t>> order(pts_.size());
-    for (std::size_t k = 0; k < pts_.size(); ++k)
-      order[k] = {Key{cell(pts_[k].p.x()), cell(pts_[k].p.y()), pts_[k].layer}, k};
-    std::sort(order.begin(), order.end(), [](const auto& u, const auto& v) {
-      return std::tie(u.first.i, u.first.j, u.first.layer, u.second) <
-             std::tie(v.first.i, v.first.j, v.first.layer, v.second);
-    });
-    std::vector<Pt> sorted(pts_.size());
-    for (std::size_t k = 0; k < order.size(); ++k) sorted[k] = pts_[order[k].second];
-    pts_ = std::move(sorted);
-    by_layer_.reserve(order.size() / 8 + 1);
-    for (std::size_t k = 0; k < order.size();) {
-      std::size_t e = k;
-      while (e < order.size() && order[e].first == order[k].first) ++e;
-      by_layer_.emplace(order[k].first, Range{k, e});
-      const Key c{order[k].first.i, order[k].first.j, 0};
-      auto [it, fresh] = by_cell_.try_emplace(c, Range{k, e});
-      if (!fresh) it->second.end = e;
-      k = e;
+  /// The samples of `moves` (for_each_sample), whose XY lie in [lo, hi].
+  PointGrid(const std::vector<PrintMove>& moves, const Vec2& lo, const Vec2& hi) {
+    if (lo.x() > hi.x()) return;
+    // A cell more on every side: a sample at a move's end may round past the box.
+    i0_ = cell(lo.x()) - 1, j0_ = cell(lo.y()) - 1;
+    ni_ = cell(hi.x()) - i0_ + 2, nj_ = cell(hi.y()) - j0_ + 2;
+    const auto cells = static_cast<std::size_t>(ni_ * nj_);
+    // Counting sort by cell, in two passes over the samples: stable, so each cell keeps the
+    // print order, and the points are held once.
+    start_.assign(cells + 1, 0);
+    for_each_sample(moves, [&](const Pt& q) { ++start_[index(cell(q.p.x()), cell(q.p.y())) + 1]; });
+    for (std::size_t c = 0; c < cells; ++c) start_[c + 1] += start_[c];
+    {
+      std::vector<std::size_t> next(start_.begin(), start_.end() - 1);
+      pts_.resize(start_[cells]);
+      for_each_sample(moves,
+                      [&](const Pt& q) { pts_[next[index(cell(q.p.x()), cell(q.p.y()))]++] = q; });
     }
+    first_run_.assign(cells + 1, 0);
+    for (std::size_t c = 0; c < cells; ++c) {
+      first_run_[c] = runs_.size();
+      for (std::size_t k = start_[c]; k < start_[c + 1]; ++k)
+        if (k == start_[c] || pts_[k].layer != pts_[k - 1].layer)
+          runs_.push_back({pts_[k].layer, k});
+    }
+    first_run_[cells] = runs_.size();
   }
   const std::vector<Pt>& points() const { return pts_; }
   /// Calls f on every point of `layer` in the 3 x 3 cells around (x, y).
@@ -69,9 +94,15 @@ class PointGrid {
     const long i = cell(x), j = cell(y);
     for (long a = i - 1; a <= i + 1; ++a)
       for (long b = j - 1; b <= j + 1; ++b) {
-        const auto it = by_layer_.find(Key{a, b, layer});
-        if (it == by_layer_.end()) continue;
-        for (std::size_t k = it->second.begin; k < it->second.end; ++k) f(pts_[k]);
+        if (!inside(a, b)) continue;
+        const std::size_t c = index(a, b);
+        const auto r0 = runs_.begin() + static_cast<std::ptrdiff_t>(first_run_[c]);
+        const auto r1 = runs_.begin() + static_cast<std::ptrdiff_t>(first_run_[c + 1]);
+        const auto r =
+            std::lower_bound(r0, r1, layer, [](const Run& u, int l) { return u.layer < l; });
+        if (r == r1 || r->layer != layer) continue;
+        const std::size_t end = r + 1 == r1 ? start_[c + 1] : (r + 1)->begin;
+        for (std::size_t k = r->begin; k < end; ++k) f(pts_[k]);
       }
   }
   /// The highest layer with a point within r (≤ kNear) of (x, y) and no higher than z_max,
@@ -81,10 +112,10 @@ class PointGrid {
     int top = -1;
     for (long a = i - 1; a <= i + 1; ++a)
       for (long b = j - 1; b <= j + 1; ++b) {
-        const auto it = by_cell_.find(Key{a, b, 0});
-        if (it == by_cell_.end()) continue;
+        if (!inside(a, b)) continue;
+        const std::size_t c = index(a, b);
         // Sorted by layer within a cell: scan down from the top, stop at the best so far.
-        for (std::size_t k = it->second.end; k-- > it->second.begin && pts_[k].layer > top;)
+        for (std::size_t k = start_[c + 1]; k-- > start_[c] && pts_[k].layer > top;)
           if (pts_[k].p.z() <= z_max && (pts_[k].p.head<2>() - Vec2(x, y)).squaredNorm() <= r * r)
             top = pts_[k].layer;
       }
@@ -93,23 +124,21 @@ class PointGrid {
 
  private:
   static long cell(double x) { return static_cast<long>(std::floor(x / kNear)); }
-  struct Key {
-    long i, j;
+  bool inside(long i, long j) const {
+    return i >= i0_ && i < i0_ + ni_ && j >= j0_ && j < j0_ + nj_;
+  }
+  std::size_t index(long i, long j) const {
+    return static_cast<std::size_t>((i - i0_) * nj_ + (j - j0_));
+  }
+  struct Run {
     int layer;
-    bool operator==(const Key&) const = default;
-  };
-  struct Hash {
-    std::size_t operator()(const Key& k) const {
-      return std::hash<long long>()((static_cast<long long>(k.i) * 73856093) ^
-                                    (static_cast<long long>(k.j) * 19349663) ^
-                                    (static_cast<long long>(k.layer) * 83492791));
-    }
-  };
-  struct Range {
-    std::size_t begin, end;
+    std::size_t begin;  ///< its first point; it ends where the cell's next run begins
   };
   std::vector<Pt> pts_;
-  std::unordered_map<Key, Range, Hash> by_layer_, by_cell_;
+  long i0_ = 0, j0_ = 0, ni_ = 0, nj_ = 0;
+  std::vector<std::size_t> start_;      ///< per cell: its first point (and one past the last)
+  std::vector<std::size_t> first_run_;  ///< per cell: its first run (and one past the last)
+  std::vector<Run> runs_;
 };
 
 // z of the least-squares plane through points of `layer` within kNear of (x, y). Points
@@ -290,21 +319,15 @@ class Deposit {
 
 constexpr double kMaxSpan = 2000.0;  // mm: larger than any bed we know; 2.4 GB of grid at most
 
-bool counts(const PrintMove& m) {
-  return m.extruding && m.layer >= 0 && m.type != "Skirt/Brim";
-}
-
-// The extrusion points (every 0.2 mm along each counted move: the coverage test allows half
-// of that beyond half a line width) and what the moves add up to.
+// What the extrusion points (for_each_sample) add up to.
 struct Samples {
-  std::vector<Pt> pts;  ///< only when asked for
   Vec2 lo{1e300, 1e300}, hi{-1e300, -1e300};
   double filament = 0;
   std::size_t extrusions = 0;
   double steepest_deg = 0;
 };
 
-Expected<Samples> sample_extrusions(const std::vector<PrintMove>& moves, bool points) {
+Expected<Samples> sample_extrusions(const std::vector<PrintMove>& moves) {
   Samples s;
   for (const PrintMove& m : moves) {
     if (!counts(m)) continue;
@@ -324,10 +347,6 @@ Expected<Samples> sample_extrusions(const std::vector<PrintMove>& moves, bool po
       return Error{Status::invalid_argument, buf};
     }
     s.extrusions += static_cast<std::size_t>(n);
-    if (points)
-      for (int k = 1; k <= n; ++k)
-        s.pts.push_back({m.from + (m.to - m.from) * (static_cast<double>(k) / n), m.layer,
-                         m.type == "Internal infill"});
     const double dxy = (m.to.head<2>() - m.from.head<2>()).norm();
     if (dxy > 0.05)
       s.steepest_deg =
@@ -490,7 +509,7 @@ Expected<CollisionFigures> find_collisions(const std::vector<PrintMove>& moves,
                                            const CheckParams& params,
                                            const std::function<bool(const Vec3&)>& looked_at,
                                            const Context& ctx) {
-  auto s = sample_extrusions(moves, false);
+  auto s = sample_extrusions(moves);
   if (!s) return s.error();
   if (s->extrusions == 0) return CollisionFigures{};
   auto f = search_collisions(moves, *s, params, looked_at, ctx);
@@ -501,12 +520,12 @@ Expected<CollisionFigures> find_collisions(const std::vector<PrintMove>& moves,
 Expected<CheckFigures> check_print(const std::vector<PrintMove>& moves, const TriangleMesh* mesh,
                                    const CheckParams& cp, const Context& ctx) {
   CheckFigures f;
-  auto s = sample_extrusions(moves, true);
+  auto s = sample_extrusions(moves);
   if (!s) return s.error();
   f.extrusions = s->extrusions, f.steepest_deg = s->steepest_deg;
   if (f.extrusions == 0) return f;
   if (ctx.cancelled()) return Error{Status::cancelled, "cancelled"};
-  const PointGrid grid(std::move(s->pts));
+  const PointGrid grid(moves, s->lo, s->hi);
   measure_thickness(grid, f);
   if (ctx.cancelled()) return Error{Status::cancelled, "cancelled"};
   ctx.progress("check", 0.3);
