@@ -76,7 +76,15 @@ ShellPlan plan_shell(const TriangleMesh& mesh, const Analysis& a, const std::vec
     s.refused = kNotOnTop;
     return s;
   }
-  s.t = p.layer_height;
+  // As thick as the nozzle tip's flat needs on the steepest facet (stack_builder's rule: a
+  // layer thinner than (r + 0.1)·tan θ − h/2 fires the collision test uphill), else the
+  // profile's layer height: at 0.15 mm and 30° the shell's layers must be 0.22 mm.
+  double steepest = 0;
+  for (int i : patches)
+    steepest = std::max(steepest, a.patches[static_cast<std::size_t>(i)].max_slope_deg);
+  const double tip = (p.toolhead.tip_radius + 0.1) * std::tan(steepest * kDeg) -
+                     0.5 * p.layer_height;
+  s.t = std::max(p.layer_height, std::ceil(tip * 100 - 1e-9) / 100);
   const double h_c =
       std::min(p.layer_height, p.max_layer_height - p.min_layer_height - 2 * kMargin);
   if (h_c < p.min_layer_height || s.t < p.min_layer_height || s.t > p.max_layer_height) {

@@ -167,10 +167,11 @@ Expected<std::optional<SliceResult>> try_shell(const TriangleMesh& mesh, const S
                 "%s: a shell of %d curved layers of %.2f mm over %zu planar core layers",
                 name.c_str(), plan.N, plan.t, plan.core.size() - 1);
   r.header.push_back(buf);
-  // What the planar attempt said of the shell's patches, and that no patch fits, is moot now.
+  // What the planar attempt said of the shell's patches, and that no patch fits, is moot now;
+  // but a setting that would let a stack fit (a stack follows the top more closely) is kept.
   for (const Notice& n : planar.notices) {
     const bool about_shell =
-        n.kind == Notice::Kind::patch_planar &&
+        n.kind == Notice::Kind::patch_planar && !n.names_a_fix &&
         std::find(plan.patches.begin(), plan.patches.end(), n.patch) != plan.patches.end();
     if (!about_shell && n.kind != Notice::Kind::none_fit) r.notices.push_back(n);
   }

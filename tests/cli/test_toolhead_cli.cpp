@@ -74,9 +74,10 @@ TEST(CliToolhead, ASaddleSteeperThanTheConeFallsBackWithANotice) {
   EXPECT_LE(j["steepest_extrusion"].get<double>(), 15.5);
 }
 
-// #16: the MK3S's 0.15 mm SPEED limits (layers 0.15, 0.07-0.25 mm) are too thin for the
-// saddle's 27° flanks under a 0.4 mm tip. The patch prints planar, and the notice names the
-// limit and the value that would clear it; that value does.
+// #16: the MK3S's 0.15 mm SPEED limits (layers 0.15, 0.07-0.25 mm) are too thin for a stack
+// on the saddle's 27° flanks under a 0.4 mm tip. The patch prints as a shell (its layers as
+// thick as the tip needs), and the notice names the limit and the value that would let a
+// stack fit; that value does.
 TEST(CliToolhead, TooThinALayerLimitIsNamedWithTheValueThatWorks) {
   const auto dir = test::temp_dir("cli_toolhead_hint");
   ASSERT_TRUE(write_stl(dir / "saddle.stl", test::saddle()));
@@ -93,7 +94,11 @@ TEST(CliToolhead, TooThinALayerLimitIsNamedWithTheValueThatWorks) {
   const double value = std::stod(s.err.substr(at + hint.size(), 4));
   EXPECT_GT(value, 0.25);
   EXPECT_LE(value, 0.30);
-  EXPECT_NE(s.err.find("0 of 1 curved patch printed curved"), std::string::npos) << s.err;
+  EXPECT_NE(s.err.find("curved shell over a planar core"), std::string::npos) << s.err;
+  const auto shell = check_json(out, mesh, " --set layer_height=0.15");
+  ASSERT_FALSE(shell.is_null());
+  EXPECT_EQ(shell["collisions"], 0);
+  EXPECT_LE(shell["top_surface_deviation"]["p95"].get<double>(), 0.02);
   char v[16];
   std::snprintf(v, sizeof v, "%.2f", value);
   const auto t =

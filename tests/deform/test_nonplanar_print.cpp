@@ -183,6 +183,34 @@ TEST(NonplanarPrint, SharedWingPrintsAsAShell) {
   EXPECT_EQ(o.result.shell_layers, 4);
 }
 
+// At 0.15 mm layers a shell of the profile's layer height put the nozzle tip's flat into
+// the layer below uphill on the wing's 27° facets (the collision test's depth is h/2), and
+// the wing went planar, as with the MK3S 0.15 SPEED preset. Its layers are now as thick as
+// the tip needs there: 0.19 mm.
+TEST(NonplanarPrint, SharedWingShellAtThinLayersClearsTheTip) {
+  const auto dir = test::shared_models();
+  if (dir.empty()) GTEST_SKIP() << "../shared/models not present";
+  auto m = load_mesh(dir / "np_curvislicer_wing.stl", {}, {});
+  ASSERT_TRUE(m);
+  PrintConfig c;
+  ASSERT_TRUE(set_config_value(c, "layer_height", "0.15"));
+  const TriangleMesh mesh = test::placed(m->mesh, c);
+  const SliceJob job = make_job(c);
+  auto r = slice_model(mesh, job, {});
+  ASSERT_TRUE(r) << r.error().message;
+  EXPECT_GT(r->shell_layers, 0);
+  auto moves = read_gcode_moves(r->gcode);
+  ASSERT_TRUE(moves) << moves.error().message;
+  auto f = check_print(*moves, &mesh, check_params(c, 30), {});
+  ASSERT_TRUE(f);
+  EXPECT_EQ(f->collisions, 0u);
+  EXPECT_LE(f->deviation_p95, 0.02);
+  EXPECT_GE(f->thickness_min, job.layers.min_layer_height - 1e-3);
+  EXPECT_LE(f->thickness_max, job.layers.max_layer_height + 1e-3);
+  // The shell's layers are thicker than the core's 0.15 mm.
+  EXPECT_GT(r->thickness_max, 0.2);
+}
+
 TEST(NonplanarPrint, FlatTopsSlicePlanarWithANotice) {
   const Outcome o = run(test::box({0, 0, 0}, {20, 20, 10}));
   EXPECT_FALSE(o.result.nonplanar);
