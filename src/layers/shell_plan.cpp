@@ -82,8 +82,8 @@ ShellPlan plan_shell(const TriangleMesh& mesh, const Analysis& a, const std::vec
   double steepest = 0;
   for (int i : patches)
     steepest = std::max(steepest, a.patches[static_cast<std::size_t>(i)].max_slope_deg);
-  const double tip = (p.toolhead.tip_radius + 0.1) * std::tan(steepest * kDeg) -
-                     0.5 * p.layer_height;
+  const double tip =
+      (p.toolhead.tip_radius + 0.1) * std::tan(steepest * kDeg) - 0.5 * p.layer_height;
   s.t = std::max(p.layer_height, std::ceil(tip * 100 - 1e-9) / 100);
   const double h_c =
       std::min(p.layer_height, p.max_layer_height - p.min_layer_height - 2 * kMargin);
