@@ -171,9 +171,14 @@ Expected<std::optional<SliceResult>> try_shell(const TriangleMesh& mesh, const S
   // but a setting that would let a stack fit (a stack follows the top more closely) is kept.
   for (const Notice& n : planar.notices) {
     const bool about_shell =
-        n.kind == Notice::Kind::patch_planar && !n.names_a_fix &&
+        n.kind == Notice::Kind::patch_planar &&
         std::find(plan.patches.begin(), plan.patches.end(), n.patch) != plan.patches.end();
-    if (!about_shell && n.kind != Notice::Kind::none_fit) r.notices.push_back(n);
+    if (n.kind == Notice::Kind::none_fit || (about_shell && !n.names_a_fix)) continue;
+    Notice kept = n;
+    if (about_shell)  // not planar after all: the shell prints it
+      kept.text = "patch " + std::to_string(n.patch) +
+                  " has no stack: " + n.text.substr(std::min(n.text.size(), n.text.find(": ") + 2));
+    r.notices.push_back(std::move(kept));
   }
   r.notices.push_back({Notice::Kind::shell, -1,
                        name + ": curved shell over a planar core (no stack over a plane fits it)"});
