@@ -50,8 +50,11 @@ int run(const CheckOptions& o) {
                                    "PrusaSlicer and OrcaSlicer)"});
   // The time with the file's own limits (its settings block, M201-M205), as PrusaSlicer's
   // viewer estimates it.
-  const double seconds =
-      estimate_print_time(read_gcode_program(bytes->view()), machine_limits(*cfg)).total;
+  const GcodeProgram program = read_gcode_program(bytes->view());
+  const double seconds = estimate_print_time(program, machine_limits(*cfg)).total;
+  // And the stealth mode's, where PrusaSlicer estimates one (the MK3S's silent_mode).
+  const double silent =
+      silent_mode_estimate(*cfg) ? estimate_print_time(program, machine_limits(*cfg, 1)).total : -1;
   if (o.json) {
     nlohmann::ordered_json j = {
         {"gcode", o.gcode},
@@ -80,6 +83,7 @@ int run(const CheckOptions& o) {
         {"outside_fraction", f->outside_fraction},
         {"extrusion_points", f->extrusions},
         {"print_time_s", seconds}};
+    if (silent >= 0) j["print_time_silent_s"] = silent;
     std::printf("%s\n", j.dump(2).c_str());
     return kExitOk;
   }
@@ -102,7 +106,9 @@ int run(const CheckOptions& o) {
   std::printf("\n");
   std::printf("  extruded / mesh volume  %.3f\n", f->volume_ratio);
   std::printf("  extrusion outside mesh  %.2f %%\n", 100 * f->outside_fraction);
-  std::printf("  print time (estimate)   %s\n", format_duration(seconds).c_str());
+  std::printf("  print time (estimate)   %s", format_duration(seconds).c_str());
+  if (silent >= 0) std::printf("  (silent mode %s)", format_duration(silent).c_str());
+  std::printf("\n");
   return kExitOk;
 }
 

@@ -33,7 +33,12 @@ Expected<std::string> make_gcode(const std::vector<LayerToolpaths>& layers, cons
 
 /// The profile's machine limits (machine_max_* keys, their first value; PrusaSlicer's
 /// defaults for the keys it does not set), for estimate_print_time.
-MachineLimits machine_limits(const PrintConfig& c);
+/// `mode` 1 reads the keys' second values, the stealth ("silent") mode's, where given.
+MachineLimits machine_limits(const PrintConfig& c, int mode = 0);
+
+/// Does PrusaSlicer estimate a silent mode too for this profile: silent_mode = 1 on a Marlin
+/// printer whose machine limits have a second (stealth) value?
+bool silent_mode_estimate(const PrintConfig& c);
 
 /// What with_print_stats measured: s, mm of filament, cm³, g (0 without filament_density).
 struct PrintStats {
@@ -50,8 +55,9 @@ PrintStats print_stats(const GcodeProgram& program, const PrintConfig& c,
 /// footer PrusaSlicer writes (filament used in mm, cm³ and g, filament cost when the profile
 /// prices it, "; estimated printing time (normal mode) = 1h 2m 3s"; any such lines already
 /// there are replaced, in place), and with remaining_times = 1 an "M73 P<percent> R<minutes
-/// left>" at every layer change (the old M73 lines dropped). Filament is the net E of every
-/// move; the time is estimate_print_time's with machine_limits(c).
+/// left>" at every layer change (the old M73 lines dropped); where silent_mode_estimate, also
+/// "M73 Q<percent> S<minutes left>" and "; estimated printing time (silent mode) = …". Filament is
+/// the net E of every move; the time is estimate_print_time's with machine_limits(c).
 std::string with_print_stats(std::string_view gcode, const PrintConfig& c,
                              PrintStats* stats = nullptr);
 

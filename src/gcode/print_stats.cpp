@@ -10,14 +10,21 @@
 namespace nonplanar {
 namespace {
 
-// The first value of a profile key ("1000,960": normal and stealth mode), if it is a number.
-std::optional<double> first_number(const PrintConfig& c, const std::string& key) {
+// Value n of a profile key ("1000,960": normal and stealth mode), if it is a number; a key
+// with fewer values gives its last, as PrusaSlicer's estimator reads it.
+std::optional<double> nth_number(const PrintConfig& c, const std::string& key, int n) {
   const auto it = c.profile.find(key);
   if (it == c.profile.end()) return std::nullopt;
-  const std::string& v = it->second;
-  const auto d = core::parse_double(std::string_view(v).substr(0, v.find(',')));
+  std::string_view v = it->second;
+  for (int k = 0; k < n && v.find(',') != std::string_view::npos; ++k)
+    v.remove_prefix(v.find(',') + 1);
+  const auto d = core::parse_double(v.substr(0, v.find(',')));
   if (!d || !std::isfinite(*d) || *d < 0) return std::nullopt;
   return d;
+}
+
+std::optional<double> first_number(const PrintConfig& c, const std::string& key) {
+  return nth_number(c, key, 0);
 }
 
 // Lines this pass writes itself: the ones an earlier writer left are dropped.
@@ -29,18 +36,26 @@ bool is_stat_line(std::string_view l) {
   return l.size() >= 4 && (l.substr(0, 4) == "M73 " || l == "M73");
 }
 
-// "M73 P40 R12": percent done and minutes left.
-std::string progress_line(double at, double total) {
+// "M73 P40 R12": percent done and minutes left ("M73 Q40 S13" for the silent mode).
+std::string progress_line(double at, double total, bool silent = false) {
   const int pct = total > 0 ? static_cast<int>(std::floor(100.0 * at / total)) : 100;
   const long left = std::lround(std::max(0.0, total - at) / 60.0);
   char buf[48];
-  std::snprintf(buf, sizeof buf, "M73 P%d R%ld\n", std::clamp(pct, 0, 100), left);
+  std::snprintf(buf, sizeof buf, silent ? "M73 Q%d S%ld\n" : "M73 P%d R%ld\n",
+                std::clamp(pct, 0, 100), left);
   return buf;
 }
 
 }  // namespace
 
-MachineLimits machine_limits(const PrintConfig& c) {
+bool silent_mode_estimate(const PrintConfig& c) {
+  const auto it = c.profile.find("machine_max_acceleration_x");
+  return c.gcode.flavor == GcodeFlavor::marlin2 &&
+         first_number(c, "silent_mode").value_or(0) != 0 && it != c.profile.end() &&
+         it->second.find(',') != std::string::npos;
+}
+
+MachineLimits machine_limits(const PrintConfig& c, int mode) {
   MachineLimits m;
   const std::pair<const char*, double*> keys[] = {
       {"machine_max_feedrate_x", &m.feed_x},
@@ -61,7 +76,7 @@ MachineLimits machine_limits(const PrintConfig& c) {
       {"machine_min_extruding_rate", &m.min_extruding_rate},
       {"machine_min_travel_rate", &m.min_travel_rate}};
   for (const auto& [key, field] : keys)
-    if (auto v = first_number(c, key)) *field = *v;
+    if (auto v = nth_number(c, key, mode)) *field = *v;
   // PrusaSlicer 2.5 writes a travel acceleration of 0 for "as extruding".
   if (m.accel_travel <= 0) m.accel_travel = m.accel_extruding;
   return m;
@@ -88,6 +103,13 @@ std::string with_print_stats(std::string_view gcode, const PrintConfig& c, Print
   const auto cost_per_kg = first_number(c, "filament_cost");
   const bool progress = first_number(c, "remaining_times").value_or(0) != 0;
   if (stats) *stats = s;
+  // The MK3S's stealth mode (PrusaSlicer's "silent mode"): its own estimate and progress.
+  const bool silent = silent_mode_estimate(c);
+  const PrintTime ts = silent ? estimate_print_time(program, machine_limits(c, 1)) : PrintTime{};
+  auto progress_at = [&](std::size_t i) {
+    return progress_line(t.line_start[i], t.total) +
+           (silent ? progress_line(ts.line_start[i], ts.total, true) : std::string());
+  };
 
   char buf[512];
   std::string block;
@@ -101,13 +123,17 @@ std::string with_print_stats(std::string_view gcode, const PrintConfig& c, Print
     block += buf;
   }
   block += "; estimated printing time (normal mode) = " + format_duration(t.total) + "\n";
+  if (silent)
+    block += "; estimated printing time (silent mode) = " + format_duration(ts.total) + "\n";
 
   std::string out;
   out.reserve(gcode.size() + gcode.size() / 50 + block.size());
   bool placed = false, finished = false;
-  if (progress) out += progress_line(0, t.total);  // first, as PrusaSlicer writes it
+  if (progress) out += progress_at(0);  // first, as PrusaSlicer writes it
   auto finish = [&] {  // 100 % once the print is done, before the footer at the latest
-    if (progress && !finished) out += progress_line(1, 1), finished = true;
+    if (!progress || finished) return;
+    out += progress_line(1, 1) + (silent ? progress_line(1, 1, true) : std::string());
+    finished = true;
   };
   auto place = [&] {
     finish();
@@ -120,7 +146,7 @@ std::string with_print_stats(std::string_view gcode, const PrintConfig& c, Print
       if (l.rfind("; ", 0) == 0) place();
       continue;
     }
-    if (progress && l == ";LAYER_CHANGE") out += progress_line(t.line_start[i], t.total);
+    if (progress && l == ";LAYER_CHANGE") out += progress_at(i);
     if (i == program.print_end) finish();
     out.append(l.data(), l.size());
     out += '\n';

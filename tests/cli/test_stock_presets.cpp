@@ -59,8 +59,8 @@ void split(const std::string& text, std::vector<std::string>& head,
 }
 
 // "1h 2m 3s" as PrusaSlicer writes its estimate, in seconds (-1: not in the file).
-double estimate_in(const std::string& gcode) {
-  const std::string key = "; estimated printing time (normal mode) = ";
+double estimate_in(const std::string& gcode, const std::string& mode = "normal") {
+  const std::string key = "; estimated printing time (" + mode + " mode) = ";
   const auto at = gcode.find(key);
   if (at == std::string::npos) return -1;
   std::stringstream ss(gcode.substr(at + key.size(), gcode.find('\n', at) - at - key.size()));
@@ -139,6 +139,16 @@ TEST(StockPresets, BlocksMatchPrusaSlicersOwnExpansion) {
     const double our_time = nlohmann::json::parse(c.out)["print_time_s"].get<double>();
     EXPECT_GT(ps_time, 60);
     EXPECT_NEAR(our_time / ps_time, 1.0, 0.03) << our_time << " s against " << ps_time << " s";
+    // The MK3S's stealth mode too, where PrusaSlicer estimates one.
+    const double ps_silent = estimate_in(test::read_bytes(theirs), "silent");
+    const auto j = nlohmann::json::parse(c.out);
+    EXPECT_EQ(ps_silent > 0, j.contains("print_time_silent_s"));
+    if (ps_silent > 0) {
+      const double our_silent = j["print_time_silent_s"].get<double>();
+      EXPECT_NEAR(our_silent / ps_silent, 1.0, 0.03)
+          << our_silent << " s against " << ps_silent << " s (silent mode)";
+      std::printf("%s silent: ours %.0f s, PrusaSlicer %.0f s\n", s.printer, our_silent, ps_silent);
+    }
     // Nothing unexpanded anywhere outside comments.
     for (const std::string& l : lines_of(test::read_bytes(ours))) {
       const std::string code = l.substr(0, l.find(';'));
@@ -178,7 +188,12 @@ void expect_curved_by_name(const fs::path& stl, const char* print, const char* e
   const std::string text = test::read_bytes(out);
   EXPECT_NEAR(estimate_in(text), j["print_time_s"].get<double>(), 1.0);
   EXPECT_NE(text.find("\nM73 P100 R0\n"), std::string::npos);
-  EXPECT_EQ(text.find("; estimated printing time"), text.rfind("; estimated printing time"));
+  for (const char* mode : {"normal", "silent"}) {  // once each (the MK3S has a stealth mode)
+    const std::string key = "; estimated printing time (" + std::string(mode) + " mode) = ";
+    EXPECT_NE(text.find(key), std::string::npos) << mode;
+    EXPECT_EQ(text.find(key), text.rfind(key)) << mode;
+  }
+  EXPECT_NE(text.find("\nM73 Q100 S0\n"), std::string::npos);
   for (const std::string& l : lines_of(text)) {
     const std::string code = l.substr(0, l.find(';'));
     EXPECT_EQ(code.find_first_of("{}[]"), std::string::npos) << l;

@@ -95,5 +95,43 @@ TEST(PrintStats, FooterAndProgressAreRecomputedInPlace) {
   EXPECT_NE(plain.find("; estimated printing time (normal mode) = 4s\n"), std::string::npos);
 }
 
+// The MK3S's stealth mode: PrusaSlicer estimates it too (silent_mode = 1, Marlin, a second
+// value in the machine limits), and writes "M73 Q S" beside every "M73 P R".
+TEST(PrintStats, SilentModeHasItsOwnEstimateAndProgress) {
+  PrintConfig c;
+  c.profile["remaining_times"] = "1";
+  c.profile["silent_mode"] = "1";
+  c.profile["machine_max_acceleration_x"] = "1000,960";
+  c.profile["machine_max_acceleration_extruding"] = "1000,250";
+  c.profile["machine_max_feedrate_x"] = "200,20";  // the silent mode caps X at 20 mm/s
+  for (const char* k : {"machine_max_jerk_x", "machine_max_jerk_y", "machine_max_jerk_e"})
+    c.profile[k] = "0";
+  ASSERT_TRUE(silent_mode_estimate(c));
+  const std::string in = "G90\nM83\n;LAYER_CHANGE\n;Z:0.2\nG1 X100 E10 F3000\n;TYPE:Custom\nM84\n";
+  // Normal: 1000 mm/s² to 50 mm/s, 2.05 s. Silent: 250 mm/s² to 20 mm/s (0.8 mm each way),
+  // 98.4 / 20 + 2 × 0.08 = 5.08 s.
+  EXPECT_NEAR(estimate_print_time(read_gcode_program(in), machine_limits(c)).total, 2.05, 1e-9);
+  EXPECT_NEAR(estimate_print_time(read_gcode_program(in), machine_limits(c, 1)).total, 5.08, 1e-9);
+  const std::string out = with_print_stats(in, c);
+  EXPECT_NE(out.find("M73 P0 R0\nM73 Q0 S0\nG90"), std::string::npos) << out;
+  EXPECT_NE(out.find("M73 P100 R0\nM73 Q100 S0\n;TYPE:Custom"), std::string::npos) << out;
+  EXPECT_NE(out.find("; estimated printing time (normal mode) = 2s\n"
+                     "; estimated printing time (silent mode) = 5s\n"),
+            std::string::npos)
+      << out;
+  // Not on Klipper, nor without the second values, nor with silent_mode = 0.
+  for (auto change : {std::pair<std::string, std::string>{"gcode_flavor", "klipper"},
+                      {"machine_max_acceleration_x", "1000"},
+                      {"silent_mode", "0"}}) {
+    PrintConfig d = c;
+    if (change.first == "gcode_flavor")
+      d.gcode.flavor = GcodeFlavor::klipper;
+    else
+      d.profile[change.first] = change.second;
+    EXPECT_FALSE(silent_mode_estimate(d)) << change.first;
+    EXPECT_EQ(with_print_stats(in, d).find("M73 Q"), std::string::npos) << change.first;
+  }
+}
+
 }  // namespace
 }  // namespace nonplanar
