@@ -9,6 +9,7 @@
 #include "nonplanar/pipeline.hpp"
 #include "nonplanar/unsupported_keys.hpp"
 #include "preview_command.hpp"
+#include "stage_timer.hpp"
 
 namespace nonplanar::cli {
 namespace {
@@ -31,7 +32,7 @@ struct SliceOptions {
   std::string output;
   std::vector<std::string> config;  ///< profiles, each over the ones before
   std::string engine = "builtin", engine_path, engine_config, engine_filaments;
-  bool planar = false, preview = false;
+  bool planar = false, preview = false, timings = false;
   double max_angle = 30.0;
   // Overrides, applied by key after the profile, in this order.
   std::vector<std::pair<std::string, std::string*>> named;  // points into values
@@ -104,6 +105,8 @@ int run(const SliceOptions& o) {
   }
 
   Context ctx = make_context(o.mesh.quiet);
+  StageTimer timer;
+  if (o.timings) timer.attach(ctx);
   LoadParams lp = o.mesh.load;
   lp.bed_center = cfg.bed_center();
   auto loaded = load_mesh(o.mesh.model, lp, ctx);
@@ -127,8 +130,10 @@ int run(const SliceOptions& o) {
     if (e.status == Status::invalid_mesh) e.message = o.mesh.model + ": " + e.message;
     return finish_progress(), report_error(e);
   }
+  timer.mark("write");
   auto w = write_gcode_text(*output, result->gcode, ctx);
   if (w && o.preview) {
+    timer.mark("preview");
     // The gate found 0 collisions; the page has the placed mesh and the file's own layers.
     PreviewSummary summary;
     summary.collisions = 0;
@@ -138,6 +143,7 @@ int run(const SliceOptions& o) {
   }
   finish_progress();
   if (!w) return report_error(w.error());
+  if (o.timings) timer.print(stderr);
   report_warnings(o.mesh.model, *loaded, o.mesh.quiet);
   if (!o.mesh.quiet) {
     for (const auto& n : result->notices)
@@ -184,6 +190,11 @@ void register_slice(CLI::App& app, std::function<int()>* run_fn) {
                   "inherits resolved; docs/orcaslicer-profiles.md) or a flat .json; repeat it for\n"
                   "a printer, a print and a filament file, each over the ones before");
   cmd->add_flag("--planar", o->planar, "Planar layers only (the ordinary slicing engine)");
+  cmd->add_flag(
+      "--timings", o->timings,
+      "Print the wall time of each stage (load, analyze, fit, layers, normalize, "
+      "slice, toolpaths or engine, map back, gate, gcode, collisions, stats, write), a retry's "
+      "stages again in order, on stderr");
   cmd->add_flag("--preview", o->preview,
                 "Also write OUTPUT.html: the toolpaths in 3D with a slider over the layers "
                 "(see 'preview')");

@@ -45,6 +45,7 @@ std::optional<Error> check_params(const AnalysisParams& p) {
 
 Expected<Analysis> analyze(const TriangleMesh& mesh, const AnalysisParams& params,
                            const Context& ctx) {
+  ctx.progress("analyze", 0);
   using namespace analysis;
   if (auto e = check_params(params)) return *e;
   constexpr double kDeg = M_PI / 180.0;

@@ -23,6 +23,7 @@ std::uint64_t edge_key(int a, int b) {
 
 Expected<NormalizedMesh> normalize_mesh(const TriangleMesh& mesh, const LayerField& field,
                                         const NormalizeParams& params, const Context& ctx) {
+  ctx.progress("normalize", 0);
   if (!std::isfinite(params.tolerance) || params.tolerance <= 0)
     return Error{Status::invalid_argument, "normalize tolerance: must be > 0"};
   NormalizedMesh out;

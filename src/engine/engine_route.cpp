@@ -28,6 +28,7 @@ Expected<EngineOutput> builtin(const TriangleMesh& to_slice, const LayerField* f
     out.layers = std::move(*paths);
     return out;
   }
+  ctx.progress("map back", 0);
   auto mapped = map_toolpaths_back(*paths, *field, route.map_back, ctx);
   if (!mapped) return mapped.error();
   out.layers = std::move(*mapped);
@@ -38,8 +39,10 @@ Expected<EngineOutput> builtin(const TriangleMesh& to_slice, const LayerField* f
 // planar field when nothing is curved, which keeps every point).
 Expected<EngineOutput> external(const TriangleMesh& to_slice, const LayerField* field,
                                 const EngineRoute& route, const Context& ctx) {
+  ctx.progress("engine", 0);
   auto text = run_engine(route.engine, to_slice, route.print, ctx);
   if (!text) return text.error();
+  ctx.progress("map back", 0);
   const auto planar = planar_field(route.layers);
   auto mapped = map_foreign_gcode(*text, field ? *field : *planar, route.map_back, ctx);
   if (!mapped) {

@@ -393,6 +393,7 @@ Expected<std::string> layer_block(const std::string& text, const char* key, Macr
 
 Expected<std::string> make_gcode(const std::vector<LayerToolpaths>& layers, const PrintConfig& c,
                                  const std::vector<std::string>& header, const Context& ctx) {
+  ctx.progress("gcode", 0);
   const GcodeParams& g = c.gcode;
   const PrintFacts facts = facts_of(layers, c);
   auto blocks = expand_blocks(c, facts);

@@ -69,6 +69,7 @@ std::optional<Error> check_params(const LoadParams& p) {
 
 Expected<LoadedMesh> load_mesh(const std::filesystem::path& file, const LoadParams& params,
                                const Context& ctx) {
+  ctx.progress("load", 0);
   if (auto e = check_params(params)) return *e;
   const std::string ext = lower_extension(file);
   if (ext != ".stl" && ext != ".obj" && ext != ".off" && ext != ".3mf")

@@ -55,6 +55,7 @@ FitError measure_fit_error(const HeightField& s, const TriangleMesh& mesh, const
 Expected<std::vector<SurfaceFit>> fit_patches(const TriangleMesh& mesh, const Analysis& analysis,
                                               const FitParams& params, const std::vector<int>& skip,
                                               std::vector<int>* patch_ids, const Context& ctx) {
+  ctx.progress("fit", 0);
   std::vector<SurfaceFit> fits;
   patch_ids->clear();
   for (std::size_t i = 0; i < analysis.patches.size(); ++i) {

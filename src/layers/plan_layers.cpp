@@ -153,6 +153,7 @@ Expected<LayerPlan> plan_layers(const TriangleMesh& mesh, const Analysis& analys
                                 const std::vector<SurfaceFit>& fits,
                                 const std::vector<int>& patch_of_fit, const LayerParams& params,
                                 StackCache& cache, const Context& ctx) {
+  ctx.progress("layers", 0);
   if (auto e = check(params)) return *e;
   if (fits.size() != patch_of_fit.size())
     return Error{Status::invalid_argument, "plan_layers: one patch index per fit expected"};

@@ -75,12 +75,14 @@ bool limits(SliceResult& r, const LayerParams& L, const Violation& violation) {
 
 Expected<bool> gate(SliceResult& r, const SliceJob& job, const layers::BandedField* banded,
                     const Violation& violation, const Context& ctx) {
+  ctx.progress("gate", 0);
   if (!limits(r, job.layers, violation)) return false;
   if (!r.nonplanar) return true;  // planar layers cannot dig into earlier ones
   // Collisions: in the program about to be written, read back as `check` reads the file, so
   // the two agree to the last digit. They are looked for even when bands already broke a
   // limit, so one retry drops every offender (each retry replans, reslices and rechecks).
   if (auto w = write_program(r, job, ctx); !w) return w.error();
+  ctx.progress("collisions", 0);
   // Only where a curved layer is within the head's reach (gate_zones.hpp): on the bunny that
   // skipped most of 24 million extrusion samples.
   GateZones zones = banded ? gate_zones(*banded, job.check.toolhead.reach()) : GateZones{};

@@ -265,6 +265,7 @@ Expected<SliceResult> slice_rounds(const TriangleMesh& mesh, const SliceJob& job
     if (deferred) {
       // No curved stack: a shell, or else the same attempt sliced planar (its stacks cached).
       r->notices.insert(r->notices.begin(), dropped.begin(), dropped.end());
+      ctx.progress("shell", 0);
       auto shell = try_shell(mesh, job, pre.analysis, *r, ctx);
       if (!shell) return shell.error();
       if (*shell) return done(std::move(**shell));
@@ -325,6 +326,7 @@ Expected<SliceResult> slice_model(const TriangleMesh& mesh, const SliceJob& job,
   if (auto w = write_program(*r, job, ctx); !w) return w.error();
   // Time, progress and filament of the file as written, by either engine (an engine's own
   // were for the flattened part).
+  ctx.progress("stats", 0);
   r->gcode = with_print_stats(r->gcode, job.print, &r->stats);
   r->notices.insert(r->notices.begin(), job.notices.begin(), job.notices.end());
   return r;

@@ -121,6 +121,7 @@ std::vector<Polygon> layer_loops(const TriangleMesh& m, const std::vector<int>& 
 
 Expected<std::vector<SlicedLayer>> slice_mesh(const TriangleMesh& mesh, const SliceParams& p,
                                               const Context& ctx) {
+  ctx.progress("slice", 0);
   if (!(p.layer_height > 0) || !(p.first_layer_height > 0) || !std::isfinite(p.layer_height) ||
       !std::isfinite(p.first_layer_height))
     return Error{Status::invalid_argument, "layer_height: must be a finite number > 0"};

@@ -64,6 +64,7 @@ ExtrusionPath make_path(ExtrusionRole role, double width, double speed, const Po
 
 Expected<std::vector<LayerToolpaths>> make_toolpaths(const std::vector<SlicedLayer>& layers,
                                                      const ToolpathParams& P, const Context& ctx) {
+  ctx.progress("toolpaths", 0);
   if (!(P.extrusion_width > 0) || !(P.perimeter_width > 0) || !(P.external_perimeter_width > 0) ||
       !(P.first_layer_width > 0))
     return Error{Status::invalid_argument, "extrusion_width: must be > 0"};

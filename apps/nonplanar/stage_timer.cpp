@@ -1,0 +1,54 @@
+#include "stage_timer.hpp"
+
+#include <map>
+
+namespace nonplanar::cli {
+
+void StageTimer::attach(Context& ctx) {
+  auto next = std::move(ctx.on_progress);
+  ctx.on_progress = [this, next](std::string_view stage, double f) {
+    report(stage);
+    if (next) next(stage, f);
+  };
+}
+
+void StageTimer::report(std::string_view stage) {
+  if (!spans_.empty() && spans_.back().stage == stage) return;
+  const Clock::time_point now = Clock::now();
+  if (!spans_.empty()) spans_.back().seconds += std::chrono::duration<double>(now - last_).count();
+  last_ = now;
+  spans_.push_back({std::string(stage), 0});
+}
+
+void StageTimer::mark(const std::string& stage) {
+  report(stage);
+}
+
+void StageTimer::print(std::FILE* out) {
+  const Clock::time_point now = Clock::now();
+  if (!spans_.empty()) spans_.back().seconds += std::chrono::duration<double>(now - last_).count();
+  last_ = now;
+  const double total = std::chrono::duration<double>(now - start_).count();
+  std::fprintf(out, "timings (wall, s):\n");
+  std::map<std::string, std::pair<double, int>> sums;
+  std::vector<std::string> order;
+  for (const Span& s : spans_) {
+    std::fprintf(out, "  %-10s %8.3f\n", s.stage.c_str(), s.seconds);
+    auto [it, fresh] = sums.try_emplace(s.stage, 0.0, 0);
+    if (fresh) order.push_back(s.stage);
+    it->second.first += s.seconds, ++it->second.second;
+  }
+  std::fprintf(out, "  per stage:");
+  for (const std::string& s : order)
+    std::fprintf(out, " %s %.3f%s", s.c_str(), sums[s].first,
+                 sums[s].second > 1 ? (" (x" + std::to_string(sums[s].second) + ")").c_str() : "");
+  // Before the first report: the command line and profiles.
+  const double before = spans_.empty() ? total : total - [&] {
+    double t = 0;
+    for (const Span& s : spans_) t += s.seconds;
+    return t;
+  }();
+  std::fprintf(out, "\n  setup %.3f, total %.3f\n", before, total);
+}
+
+}  // namespace nonplanar::cli

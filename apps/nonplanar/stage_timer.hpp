@@ -1,0 +1,35 @@
+// `slice --timings`: wall time per pipeline stage, read from the stages' progress reports (a
+// stage reports 0 when it starts; context.hpp). A span runs from a stage's first report to the
+// next report of another stage, so a retry shows as the same stages again, in order.
+#pragma once
+
+#include <chrono>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "nonplanar/context.hpp"
+
+namespace nonplanar::cli {
+
+class StageTimer {
+ public:
+  /// Records every report that goes through `ctx` (and still passes it on).
+  void attach(Context& ctx);
+  /// Ends the current span and starts `stage` (for work outside the library: "write").
+  void mark(const std::string& stage);
+  /// The spans in order, then the totals per stage and the run's wall time, on `out`.
+  void print(std::FILE* out);
+
+ private:
+  using Clock = std::chrono::steady_clock;
+  struct Span {
+    std::string stage;
+    double seconds = 0;
+  };
+  void report(std::string_view stage);
+  Clock::time_point start_ = Clock::now(), last_ = start_;
+  std::vector<Span> spans_;
+};
+
+}  // namespace nonplanar::cli

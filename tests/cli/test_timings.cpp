@@ -1,0 +1,46 @@
+// `slice --timings` (#20): the stages' wall times, read from their progress reports.
+#include <gtest/gtest.h>
+
+#include <regex>
+#include <string>
+
+#include "support/cli.hpp"
+
+namespace nonplanar {
+namespace {
+
+namespace fs = std::filesystem;
+
+TEST(Timings, EveryStageOfACurvedSliceIsTimedAndTheSpansAddUp) {
+  const fs::path dir = test::temp_dir("timings");
+  test::write_bytes(dir / "roof.stl", test::ascii_stl(test::sine_roof(), "\n"));
+  const auto r = test::run_cli("slice " + (dir / "roof.stl").string() + " -o " +
+                               (dir / "roof.gcode").string() + " --timings");
+  ASSERT_EQ(r.code, 0) << r.err;
+  // The spans, in order, one per line: "  NAME  SECONDS".
+  std::vector<std::string> order;
+  double sum = 0;
+  const std::regex span(R"(\n  ([a-z ]+?) +([0-9]+\.[0-9]{3})(?=\n))");
+  for (auto it = std::sregex_iterator(r.err.begin(), r.err.end(), span);
+       it != std::sregex_iterator(); ++it) {
+    order.push_back((*it)[1]);
+    sum += std::stod((*it)[2]);
+  }
+  // The gate checks the limits, writes the program, then looks for collisions in it.
+  const std::vector<std::string> want = {
+      "load",     "analyze", "fit",   "layers",     "normalize", "slice", "toolpaths",
+      "map back", "gate",    "gcode", "collisions", "stats",     "write"};
+  EXPECT_EQ(order, want) << r.err;
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(r.err, m, std::regex(R"(setup ([0-9.]+), total ([0-9.]+))")))
+      << r.err;
+  EXPECT_NEAR(sum + std::stod(m[1]), std::stod(m[2]), 0.01);
+  EXPECT_GT(sum, 0);
+  // Without the flag, nothing of it.
+  const auto q = test::run_cli("slice -q " + (dir / "roof.stl").string() + " -o " +
+                               (dir / "roof.gcode").string());
+  EXPECT_EQ(q.err.find("timings"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace nonplanar
