@@ -32,8 +32,10 @@ void StageTimer::print(std::FILE* out) {
   std::fprintf(out, "timings (wall, s):\n");
   std::map<std::string, std::pair<double, int>> sums;
   std::vector<std::string> order;
+  double timed = 0;
   for (const Span& s : spans_) {
     std::fprintf(out, "  %-10s %8.3f\n", s.stage.c_str(), s.seconds);
+    timed += s.seconds;
     auto [it, fresh] = sums.try_emplace(s.stage, 0.0, 0);
     if (fresh) order.push_back(s.stage);
     it->second.first += s.seconds, ++it->second.second;
@@ -43,12 +45,7 @@ void StageTimer::print(std::FILE* out) {
     std::fprintf(out, " %s %.3f%s", s.c_str(), sums[s].first,
                  sums[s].second > 1 ? (" (x" + std::to_string(sums[s].second) + ")").c_str() : "");
   // Before the first report: the command line and profiles.
-  const double before = spans_.empty() ? total : total - [&] {
-    double t = 0;
-    for (const Span& s : spans_) t += s.seconds;
-    return t;
-  }();
-  std::fprintf(out, "\n  setup %.3f, total %.3f\n", before, total);
+  std::fprintf(out, "\n  setup %.3f, total %.3f\n", total - timed, total);
 }
 
 }  // namespace nonplanar::cli
