@@ -18,6 +18,8 @@ struct CheckOptions {
   ProfileOptions profile;
   std::string gcode;
   double max_angle = 30;
+  double min_angle = 0;
+  double tolerance = 0.03;
   bool json = false;
 };
 
@@ -28,7 +30,14 @@ int run(const CheckOptions& o) {
   // The file's own settings first; presets, --config and --set go over them.
   auto cfg = o.profile.load(file_config(o.gcode, bytes->view(), o.mesh.quiet || o.json));
   if (!cfg) return report_error(cfg.error());
-  const CheckParams params = check_params(*cfg, o.max_angle);
+  if (!(o.min_angle >= 0 && o.min_angle < o.max_angle))
+    return report_error({Status::invalid_argument,
+                         "--min-angle: must be at least 0 and below --max-angle"});
+  if (!(o.tolerance > 0 && o.tolerance < 100))
+    return report_error({Status::invalid_argument, "--tolerance: must be in (0, 100) mm"});
+  CheckParams params = check_params(*cfg, o.max_angle);
+  params.min_angle_deg = o.min_angle;
+  params.within_tolerance = o.tolerance;
   Context ctx = make_context(o.mesh.quiet || o.json);
   auto moves = read_gcode_moves(bytes->view());
   if (!moves)
@@ -64,7 +73,12 @@ int run(const CheckOptions& o) {
           {"p95", f->deviation_p95},
           {"max", f->deviation_max},
           {"samples", f->surface_samples},
-          {"covered_samples", f->covered_samples}}},
+          {"covered_samples", f->covered_samples},
+          {"within_samples", f->within_samples},
+          {"within_share", f->within_share},
+          {"tolerance", o.tolerance},
+          {"min_angle", o.min_angle},
+          {"max_angle", o.max_angle}}},
         {"thickness_min", f->thickness_min},
         {"thickness_max", f->thickness_max},
         {"thickness_min_at",
@@ -92,6 +106,8 @@ int run(const CheckOptions& o) {
       "  top-surface deviation   mean %.4f  p95 %.4f  max %.4f mm  (%zu of %zu samples covered)\n",
       f->deviation_mean, f->deviation_p95, f->deviation_max, f->covered_samples,
       f->surface_samples);
+  std::printf("  within %.3f mm          %.1f %% of the top's samples (facets %g-%g deg)\n",
+              o.tolerance, 100 * f->within_share, o.min_angle, o.max_angle);
   std::printf(
       "  layer thickness         %.3f - %.3f mm  (thinnest at x %.2f y %.2f z %.2f, thickest "
       "at x %.2f y %.2f z %.2f)\n",
@@ -128,6 +144,14 @@ void register_check(CLI::App& app, std::function<int()>* run_fn) {
   o->profile.add_to(*cmd, "bed size, filament, layer height, the toolhead");
   cmd->add_option("--scale", o->mesh.load.scale, "Scale applied when slicing");
   cmd->add_option("--max-angle", o->max_angle, "Printable facet slope (deg)")
+      ->capture_default_str();
+  cmd->add_option("--min-angle", o->min_angle,
+                  "Sample only facets at least this steep (deg): 2 leaves the flat tops out, "
+                  "so the figures are the curved top's")
+      ->capture_default_str();
+  cmd->add_option("--tolerance", o->tolerance,
+                  "The 'within' figure: share of the top's samples covered and at most this "
+                  "far off (mm)")
       ->capture_default_str();
   // The head, as options too (kept from before the profile carried it).
   o->profile.add_keyed(*cmd, "--nozzle-tip-radius", "nozzle_tip_radius",

@@ -21,7 +21,14 @@ struct CheckParams {
   double layer_height = 0.2;  ///< h: a collision is a penetration deeper than h / 2
   Toolhead toolhead;          ///< what may not touch earlier material (toolhead.hpp)
   double filament_diameter = 1.75;
+  /// Top-surface samples per mm² of facet: a facet smaller than one sample's share gets one
+  /// only as its area adds up, so a finely meshed region counts no more than a coarse one.
   double surface_samples_per_mm2 = 2;
+  /// The facets the deviation samples: at least min_angle_deg and below max_angle_deg from
+  /// horizontal (2: the curved top only, the flat tops left out).
+  double min_angle_deg = 0;
+  /// A sample is "within" when a layer covers it and its deviation is at most this, mm.
+  double within_tolerance = 0.03;
 };
 
 /// The figures of DESIGN.md §4. Deviation is vertical, mm; thickness is the height of each
@@ -29,6 +36,10 @@ struct CheckParams {
 /// 0.6 mm); angles in degrees.
 struct CheckFigures {
   std::size_t surface_samples = 0, covered_samples = 0;
+  /// Samples covered and at most within_tolerance off, over all samples (an uncovered sample
+  /// is not within): the share of the top printed where the mesh says. 0 without samples.
+  std::size_t within_samples = 0;
+  double within_share = 0;
   double deviation_mean = 0, deviation_p95 = 0, deviation_max = 0;
   double thickness_min = 0, thickness_max = 0;
   Vec3 thickness_min_at{0, 0, 0}, thickness_max_at{0, 0, 0};  ///< the extrusion samples

@@ -459,32 +459,48 @@ void measure_volume(const PointGrid& grid, const TriangleMesh& mesh, double fila
   f.outside_fraction = tested ? static_cast<double>(outside) / static_cast<double>(tested) : 0.0;
 }
 
-// Top-surface deviation on printable up-facing facets.
+// Top-surface deviation on printable up-facing facets between min_angle and max_angle. Samples
+// are spread by area: a facet gets the largest lattice its area pays for (m(m + 1)/2 ≤
+// density · area points); what is left over is carried from facet to facet, and a facet
+// gets a sample at its centroid each time it adds up to one, so a fine mesh does not weigh its
+// small facets more than a coarse one.
 void measure_deviation(const PointGrid& grid, const TriangleMesh& mesh, const CheckParams& cp,
                        CheckFigures& f) {
   std::vector<double> dev;
   const double cos_max = std::cos(cp.max_angle_deg * M_PI / 180.0);
+  const double cos_min = std::cos(std::max(cp.min_angle_deg, 0.0) * M_PI / 180.0);
+  const double density = cp.surface_samples_per_mm2;
+  double carried = 0;  // what the facets so far left over, in samples
+  auto sample = [&](const Vec3& s) {
+    ++f.surface_samples;
+    // The layer that prints this surface: the highest one whose extrusion covers this XY
+    // within half a line width, ignoring material more than 1 mm above it (another part
+    // of the model over this one, as an arch).
+    const int top = grid.top_layer(s.x(), s.y(), 0.225 + 0.1, s.z() + 1.0);
+    double z = 0;
+    if (top < 0 || !plane_z(grid, top, s.x(), s.y(), &z)) return;
+    ++f.covered_samples;
+    const double d = std::abs(z - s.z());
+    f.within_samples += d <= cp.within_tolerance;
+    dev.push_back(d);
+  };
   for (const auto& t : mesh.faces) {
     const Vec3 &a = mesh.vertices[t[0]], &b = mesh.vertices[t[1]], &c = mesh.vertices[t[2]];
     const Vec3 nrm = (b - a).cross(c - a);
     const double area = 0.5 * nrm.norm();
-    if (area <= 0 || nrm.z() / nrm.norm() <= cos_max) continue;
-    const int m = std::max(1, static_cast<int>(std::floor(
-                                  (std::sqrt(8 * cp.surface_samples_per_mm2 * area + 1) - 1) / 2)));
+    if (!(area > 0)) continue;
+    const double nz = nrm.z() / nrm.norm();
+    if (nz <= cos_max || (cp.min_angle_deg > 0 && nz > cos_min)) continue;
+    const int m = static_cast<int>(std::floor((std::sqrt(8 * density * area + 1) - 1) / 2));
+    carried += density * area - 0.5 * m * (m + 1);
+    if (carried >= 1) carried -= 1, sample((a + b + c) / 3.0);
     for (int i = 0; i < m; ++i)
-      for (int j = 0; i + j < m; ++j) {
-        const Vec3 s = a + (i + 1.0 / 3.0) / m * (b - a) + (j + 1.0 / 3.0) / m * (c - a);
-        ++f.surface_samples;
-        // The layer that prints this surface: the highest one whose extrusion covers this XY
-        // within half a line width, ignoring material more than 1 mm above it (another part
-        // of the model over this one, as an arch).
-        const int top = grid.top_layer(s.x(), s.y(), 0.225 + 0.1, s.z() + 1.0);
-        double z = 0;
-        if (top < 0 || !plane_z(grid, top, s.x(), s.y(), &z)) continue;
-        ++f.covered_samples;
-        dev.push_back(std::abs(z - s.z()));
-      }
+      for (int j = 0; i + j < m; ++j)
+        sample(a + (i + 1.0 / 3.0) / m * (b - a) + (j + 1.0 / 3.0) / m * (c - a));
   }
+  if (f.surface_samples > 0)
+    f.within_share =
+        static_cast<double>(f.within_samples) / static_cast<double>(f.surface_samples);
   if (dev.empty()) return;
   std::sort(dev.begin(), dev.end());
   double sum = 0;

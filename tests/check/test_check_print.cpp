@@ -3,6 +3,8 @@
 // gate's collisions-only mode agreeing with the full check.
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "nonplanar/check.hpp"
 #include "support/solids.hpp"
 
@@ -109,6 +111,48 @@ TEST(CheckPrint, DeviationIgnoresMaterialFarAbove) {
   ASSERT_TRUE(f);
   EXPECT_GT(f->covered_samples, 0.9 * static_cast<double>(f->surface_samples));
   EXPECT_LT(f->deviation_max, 1e-6);  // both tops printed exactly at their heights
+}
+
+
+// The top's samples are spread by area, not by facet: a 10 x 10 mm top whose left half is
+// 800 tiny facets and right half 2 large ones, printed right (z = 0.2) over the right half
+// and 0.1 mm too high over the left, is within 0.03 mm on the right half's samples less a
+// strip of about 0.7 mm where the height plane takes points of both halves: 0.43. (Taking
+// every facet once at least gave the left half 800 of 900 samples: a share of 0.05.)
+TEST(CheckPrint, TopSamplesAreSpreadByAreaAndCountedWithinTheTolerance) {
+  TriangleMesh top;
+  auto quad = [&](double x0, double y0, double x1, double y1) {
+    const int b = static_cast<int>(top.vertices.size());
+    top.vertices.push_back({x0, y0, 0.2}), top.vertices.push_back({x1, y0, 0.2});
+    top.vertices.push_back({x1, y1, 0.2}), top.vertices.push_back({x0, y1, 0.2});
+    top.faces.push_back({b, b + 1, b + 2}), top.faces.push_back({b, b + 2, b + 3});
+  };
+  for (int i = 0; i < 20; ++i)
+    for (int j = 0; j < 20; ++j) quad(0.25 * i, 0.5 * j, 0.25 * (i + 1), 0.5 * (j + 1));
+  quad(5, 0, 10, 10);
+  std::vector<PrintMove> moves;
+  for (double y = 0; y <= 10 + 1e-9; y += 0.45) {
+    PrintMove m;
+    m.extruding = true, m.layer = 0, m.type = "Top solid infill", m.filament = 0.1;
+    m.from = {0, y, 0.3}, m.to = {5, y, 0.3};
+    moves.push_back(m);
+    m.from = {5.2, y, 0.2}, m.to = {10, y, 0.2};
+    moves.push_back(m);
+  }
+  CheckParams cp;
+  auto f = check_print(moves, &top, cp, {});
+  ASSERT_TRUE(f);
+  EXPECT_NEAR(static_cast<double>(f->surface_samples), 200, 12);  // 2 per mm² of 100 mm²
+  EXPECT_EQ(f->covered_samples, f->surface_samples);
+  EXPECT_NEAR(f->within_share, 0.43, 0.03);
+  EXPECT_EQ(f->within_samples, static_cast<std::size_t>(std::lround(
+                                   f->within_share * static_cast<double>(f->surface_samples))));
+  // Only facets at least 2° from horizontal: this flat top has none.
+  cp.min_angle_deg = 2;
+  f = check_print(moves, &top, cp, {});
+  ASSERT_TRUE(f);
+  EXPECT_EQ(f->surface_samples, 0u);
+  EXPECT_EQ(f->within_share, 0);
 }
 
 }  // namespace
