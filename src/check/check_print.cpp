@@ -444,11 +444,10 @@ Expected<CollisionFigures> search_collisions(const std::vector<PrintMove>& moves
 }
 
 // Volume ratio and extrusion outside the mesh.
-void measure_volume(const PointGrid& grid, const TriangleMesh& mesh, double filament,
-                    const CheckParams& cp, CheckFigures& f) {
+void measure_volume(const PointGrid& grid, const ColumnCaster& cols, const TriangleMesh& mesh,
+                    double filament, const CheckParams& cp, CheckFigures& f) {
   f.volume_ratio = filament * M_PI * 0.25 * cp.filament_diameter * cp.filament_diameter /
                    std::max(signed_volume(mesh), 1e-12);
-  const ColumnCaster cols(mesh);
   const std::vector<Pt>& all = grid.points();
   std::size_t outside = 0, tested = 0;
   for (std::size_t k = 0; k < all.size(); k += 2) {
@@ -463,9 +462,10 @@ void measure_volume(const PointGrid& grid, const TriangleMesh& mesh, double fila
 // are spread by area: a facet gets the largest lattice its area pays for (m(m + 1)/2 ≤
 // density · area points); what is left over is carried from facet to facet, and a facet
 // gets a sample at its centroid each time it adds up to one, so a fine mesh does not weigh its
-// small facets more than a coarse one.
-void measure_deviation(const PointGrid& grid, const TriangleMesh& mesh, const CheckParams& cp,
-                       CheckFigures& f) {
+// small facets more than a coarse one. A facet inside another body of the mesh (a box's top
+// inside the dome set on it) is no surface and takes no samples.
+void measure_deviation(const PointGrid& grid, const ColumnCaster& cols, const TriangleMesh& mesh,
+                       const CheckParams& cp, CheckFigures& f) {
   std::vector<double> dev;
   const double cos_max = std::cos(cp.max_angle_deg * M_PI / 180.0);
   const double cos_min = std::cos(std::max(cp.min_angle_deg, 0.0) * M_PI / 180.0);
@@ -491,9 +491,11 @@ void measure_deviation(const PointGrid& grid, const TriangleMesh& mesh, const Ch
     if (!(area > 0)) continue;
     const double nz = nrm.z() / nrm.norm();
     if (nz <= cos_max || (cp.min_angle_deg > 0 && nz > cos_min)) continue;
+    const Vec3 mid = (a + b + c) / 3.0;
+    if (cols.inside(mid.x(), mid.y(), mid.z() + 0.05)) continue;
     const int m = static_cast<int>(std::floor((std::sqrt(8 * density * area + 1) - 1) / 2));
     carried += density * area - 0.5 * m * (m + 1);
-    if (carried >= 1) carried -= 1, sample((a + b + c) / 3.0);
+    if (carried >= 1) carried -= 1, sample(mid);
     for (int i = 0; i < m; ++i)
       for (int j = 0; i + j < m; ++j)
         sample(a + (i + 1.0 / 3.0) / m * (b - a) + (j + 1.0 / 3.0) / m * (c - a));
@@ -552,8 +554,9 @@ Expected<CheckFigures> check_print(const std::vector<PrintMove>& moves, const Tr
   ctx.progress("check", 0.6);
   if (!mesh) return f;
   if (ctx.cancelled()) return Error{Status::cancelled, "cancelled"};
-  measure_volume(grid, *mesh, s->filament, cp, f);
-  measure_deviation(grid, *mesh, cp, f);
+  const ColumnCaster cols(*mesh);
+  measure_volume(grid, cols, *mesh, s->filament, cp, f);
+  measure_deviation(grid, cols, *mesh, cp, f);
   ctx.progress("check", 1.0);
   return f;
 }
