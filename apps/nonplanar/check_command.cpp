@@ -31,8 +31,8 @@ int run(const CheckOptions& o) {
   auto cfg = o.profile.load(file_config(o.gcode, bytes->view(), o.mesh.quiet || o.json));
   if (!cfg) return report_error(cfg.error());
   if (!(o.min_angle >= 0 && o.min_angle < o.max_angle))
-    return report_error({Status::invalid_argument,
-                         "--min-angle: must be at least 0 and below --max-angle"});
+    return report_error(
+        {Status::invalid_argument, "--min-angle: must be at least 0 and below --max-angle"});
   if (!(o.tolerance > 0 && o.tolerance < 100))
     return report_error({Status::invalid_argument, "--tolerance: must be in (0, 100) mm"});
   CheckParams params = check_params(*cfg, o.max_angle);

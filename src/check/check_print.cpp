@@ -501,8 +501,7 @@ void measure_deviation(const PointGrid& grid, const ColumnCaster& cols, const Tr
         sample(a + (i + 1.0 / 3.0) / m * (b - a) + (j + 1.0 / 3.0) / m * (c - a));
   }
   if (f.surface_samples > 0)
-    f.within_share =
-        static_cast<double>(f.within_samples) / static_cast<double>(f.surface_samples);
+    f.within_share = static_cast<double>(f.within_samples) / static_cast<double>(f.surface_samples);
   if (dev.empty()) return;
   std::sort(dev.begin(), dev.end());
   double sum = 0;

@@ -91,6 +91,11 @@ TriangleMesh cut_below(const TriangleMesh& mesh, double z0) {
 
 Expected<EngineShell> shell_with_engine(const TriangleMesh& mesh, const layers::ShellPlan& plan,
                                         const EngineRoute& job, const Context& ctx) {
+  // One engine run cannot stop its core part-way for the shell and go on after it.
+  if (!plan.region.empty())
+    return Error{Status::unsupported,
+                 "through an engine, a shell prints only where the part stands nowhere above "
+                 "its top (the built-in engine prints this one)"};
   // The core: the whole mesh sliced on the plan's boundaries (its skins then sit under the
   // real top, so the shell counts as their cover), each layer cut back under the shell.
   EngineRun core_run;

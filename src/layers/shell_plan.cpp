@@ -51,8 +51,6 @@ double ShellPlan::thickness(int j, double x, double y) const {
   return u - std::max(below, 0.0);
 }
 
-const char* const kNotOnTop = "the part's highest point is not on the patches";
-
 ShellPlan plan_shell(const TriangleMesh& mesh, const Analysis& a, const std::vector<int>& patches,
                      const LayerParams& p) {
   ShellPlan s;
@@ -72,10 +70,6 @@ ShellPlan plan_shell(const TriangleMesh& mesh, const Analysis& a, const std::vec
     return s;
   }
   const BoundingBox box = bounding_box(mesh);
-  if (P.z_max < box.max.z() - 0.05) {
-    s.refused = kNotOnTop;
-    return s;
-  }
   // As thick as the nozzle tip's flat needs on the steepest facet (stack_builder's rule: a
   // layer thinner than (r + 0.1)·tan θ − h/2 fires the collision test uphill), else the
   // profile's layer height: at 0.15 mm and 30° the shell's layers must be 0.22 mm.
@@ -101,27 +95,22 @@ ShellPlan plan_shell(const TriangleMesh& mesh, const Analysis& a, const std::vec
                      1.0;
   s.top = faceted_top(mesh, P, 0.1, pad, std::tan(0.8 * p.max_angle_deg * kDeg) / M_SQRT2);
 
-  // The patch must be the part's whole top: nothing of the mesh above H (its vertices, and
-  // its edges every 0.5 mm), no overhang and no other printable up-facing surface within half
-  // a millimetre under the shell.
+  // Where the part stands above H, the shell prints only in R (shell_region.hpp). Inside R,
+  // no overhang and no other printable up-facing surface may lie within half a millimetre
+  // under the shell.
   std::vector<char> in_patch(mesh.faces.size(), 0);
   for (int f : P.faces) in_patch[static_cast<std::size_t>(f)] = 1;
+  ShellRegion region = shell_region(mesh, in_patch, s.top, p);
+  if (!region.refused.empty()) {
+    s.refused = region.refused;
+    return s;
+  }
+  s.region = std::move(region.mask);
   const double cos_max = std::cos(p.max_angle_deg * kDeg);
   for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
+    if (in_patch[f]) continue;
     const auto& F = mesh.faces[f];
     const Vec3 v[3] = {mesh.vertices[F[0]], mesh.vertices[F[1]], mesh.vertices[F[2]]};
-    for (int k = 0; k < 3; ++k) {
-      const Vec3 &A = v[k], &B = v[(k + 1) % 3];
-      const int n = 1 + static_cast<int>((B - A).head<2>().norm() / 0.5);
-      for (int i = 0; i < n; ++i) {
-        const Vec3 q = A + (B - A) * (static_cast<double>(i) / n);
-        if (q.z() > s.top.height(q.x(), q.y()) + 0.02) {
-          s.refused = at("the part stands above the curved top", q);
-          return s;
-        }
-      }
-    }
-    if (in_patch[f]) continue;
     const Vec3 nrm = (v[1] - v[0]).cross(v[2] - v[0]);
     const double len = nrm.norm();
     if (!(len > 0)) continue;
@@ -132,7 +121,7 @@ ShellPlan plan_shell(const TriangleMesh& mesh, const Analysis& a, const std::vec
     if (!overhang && !printable_top) continue;
     const Vec3 c = (v[0] + v[1] + v[2]) / 3.0;
     for (const Vec3& q : {v[0], v[1], v[2], c})
-      if (q.z() > s.bottom(q.x(), q.y()) - 0.5) {
+      if (s.in_region(q.x(), q.y()) && q.z() > s.bottom(q.x(), q.y()) - 0.5) {
         s.refused = at(overhang ? "an overhang lies under the shell"
                                 : "another printable surface lies under the shell",
                        q);
@@ -148,8 +137,27 @@ ShellPlan plan_shell(const TriangleMesh& mesh, const Analysis& a, const std::vec
   for (const Patch& q : a.patches)
     if (q.verdict == PatchVerdict::flat && q.z_max - q.z_min < 0.05)
       targets.push_back(0.5 * (q.z_min + q.z_max));  // the wing's tilted floor: 3.55–3.58 mm
+  if (!s.region.empty()) end = box.max.z();          // the part outside R goes on above the shell
   s.core =
       core_boundaries(std::min(p.first_layer_height, h_c), h_c, p.min_layer_height, end, targets);
+  if (!s.region.empty() && std::isfinite(region.z_lo + region.z_hi)) {
+    // The core boundary nearest the middle of z_ins's interval.
+    const double mid = 0.5 * (region.z_lo + region.z_hi);
+    double best = std::numeric_limits<double>::infinity();
+    for (double z : s.core)
+      if (z >= region.z_lo && z <= region.z_hi && std::abs(z - mid) < std::abs(best - mid))
+        best = z;
+    if (!std::isfinite(best)) {
+      char buf[200];
+      std::snprintf(buf, sizeof buf,
+                    "the part stands above the curved top, and no core layer ends between z = "
+                    "%.2f and %.2f mm, where the shell would have to print",
+                    region.z_lo, region.z_hi);
+      s.refused = buf;
+      return s;
+    }
+    s.insert_z = best;
+  }
   return s;
 }
 

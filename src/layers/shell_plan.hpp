@@ -16,10 +16,12 @@
 #pragma once
 
 #include <algorithm>
+#include <limits>
 #include <string>
 #include <vector>
 
 #include "layers/faceted_top.hpp"
+#include "layers/shell_region.hpp"
 #include "nonplanar/layers.hpp"
 
 namespace nonplanar::layers {
@@ -32,6 +34,14 @@ struct ShellPlan {
   double reach = 0;          ///< a, mm
   std::vector<double> core;  ///< z_0 = 0 … z_K, the core's layer boundaries, mm
   std::string refused;       ///< why the part cannot be printed this way (empty: it can)
+  /// Where the shell prints (shell_region.hpp): empty when the part stands nowhere above H,
+  /// else +1 on R's nodes. Outside R the core prints every layer whole.
+  FacetedTop region;
+  /// The core's layers with top above this print their part outside R after the shell, mm
+  /// (+inf: the whole core first, then the shell).
+  double insert_z = std::numeric_limits<double>::infinity();
+
+  bool in_region(double x, double y) const { return region.empty() || region.height(x, y) >= 0; }
 
   double bottom(double x, double y) const { return top.height(x, y) - N * t; }
   /// The core's layer with top z is printed where H >= this level (z <= B + a), mm.
@@ -45,14 +55,12 @@ struct ShellPlan {
   double thickness(int j, double x, double y) const;
 };
 
-/// `refused` when the part's highest point is not on the patches (the usual case: a part with
-/// a curved top somewhere on it, not all over it).
-extern const char* const kNotOnTop;
-
 /// Inputs: the placed mesh, its analysis, the patches to follow together (indices into
-/// a.patches) and the printer limits. Output: a plan, or one with `refused` set when they are not
-/// the part's whole top (some of the mesh stands above H), another printable up-facing surface or
-/// an overhang lies inside the shell, or the limits leave no room for the stairs. The core's
+/// a.patches) and the printer limits. Output: a plan, or one with `refused` set when the part
+/// stands above most of the patches or above them where no one moment in the core's order can
+/// print the shell (shell_region.hpp), another printable up-facing surface or an overhang lies
+/// inside the shell, or the limits leave no room for the stairs. Where some of the part stands
+/// above H, the shell prints only in R and at insert_z in the core's order. The core's
 /// boundaries land on every flat patch's height that they can reach in steps within
 /// [h_min, h_c].
 ShellPlan plan_shell(const TriangleMesh& mesh, const Analysis& a, const std::vector<int>& patches,

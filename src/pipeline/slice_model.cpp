@@ -148,7 +148,7 @@ Expected<std::optional<SliceResult>> try_shell(const TriangleMesh& mesh, const S
     return Notice{Notice::Kind::shell_refused, -1, name + " not printed as a shell: " + why};
   };
   if (!plan.refused.empty()) {
-    if (plan.refused != layers::kNotOnTop) planar.notices.push_back(refused(plan.refused));
+    planar.notices.push_back(refused(plan.refused));
     return std::optional<SliceResult>{};
   }
   SliceResult r;

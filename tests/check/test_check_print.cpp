@@ -113,7 +113,6 @@ TEST(CheckPrint, DeviationIgnoresMaterialFarAbove) {
   EXPECT_LT(f->deviation_max, 1e-6);  // both tops printed exactly at their heights
 }
 
-
 // The top's samples are spread by area, not by facet: a 10 x 10 mm top whose left half is
 // 800 tiny facets and right half 2 large ones, printed right (z = 0.2) over the right half
 // and 0.1 mm too high over the left, is within 0.03 mm on the right half's samples less a

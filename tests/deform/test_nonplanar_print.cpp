@@ -170,6 +170,34 @@ TEST(NonplanarPrint, RibTopFromNearTheBedPrintsAsAShell) {
   EXPECT_NE(o.result.notices.back().text.find("curved shell"), std::string::npos);
 }
 
+// The rib with a 14 mm tower 2 mm past its end, taller than the rib's top: the shell prints
+// where nothing stands above it, after the core's layers up to the rib's height beside the
+// tower (7.36 mm, the middle of what the cone allows there), and the tower's layers above that
+// after the shell, travelling over it lifted. Before, the part went planar ("the part's
+// highest point is not on the patches").
+TEST(NonplanarPrint, RibBesideATallerTowerPrintsAsAShellBetweenTheTowersLayers) {
+  PrintConfig c;
+  c.paths.fill_density = 1.0;
+  TriangleMesh m = test::rib();
+  test::append(m, test::box({82, 4, 0}, {86, 8, 14}));
+  const Outcome o = run(m, c);
+  expect_good(o, 0);
+  EXPECT_EQ(o.result.shell_layers, 4);
+  EXPECT_LE(o.figures.deviation_p95, 0.005);
+  EXPECT_GT(o.figures.within_share, 0.95);
+  EXPECT_NEAR(o.figures.volume_ratio, 1.0, 0.03);
+  // Layers go up to the tower's top, and after the shell some start lower than its top.
+  double highest = 0, lowest_after_shell = 1e9;
+  bool after_shell = false;
+  for (const LayerToolpaths& L : o.result.layers) {
+    highest = std::max(highest, L.max_z);
+    if (after_shell) lowest_after_shell = std::min(lowest_after_shell, L.z);
+    after_shell |= L.max_z > 12.2;  // the shell reaches the rib's top, 12.3 mm
+  }
+  EXPECT_NEAR(highest, 14.0, 0.2);
+  EXPECT_LT(lowest_after_shell, 8.0);
+}
+
 // The CurviSlicer wing: its top runs from the bed at the nose to 17.5 mm; its windows' floors
 // (3.12 and 3.55-3.58 mm, 29 % of the printable area) are planar core layer boundaries.
 // PrusaSlicer's planar p95 on it is 0.089 mm; before the shell ours was the same.

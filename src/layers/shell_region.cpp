@@ -1,0 +1,192 @@
+// Notation as in shell_region.hpp.
+#include "layers/shell_region.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+namespace nonplanar::layers {
+namespace {
+
+constexpr double kAbove = 0.02;  ///< mm: the part stands above H by more than this
+
+std::string at(const char* what, const Vec3& p) {
+  char buf[240];
+  std::snprintf(buf, sizeof buf, "%s at (%.2f, %.2f, %.2f)", what, p.x(), p.y(), p.z());
+  return buf;
+}
+
+struct Raster {
+  const FacetedTop& t;
+  std::size_t index(int i, int j) const { return static_cast<std::size_t>(i) * t.ny + j; }
+  Vec2 node(int i, int j) const { return t.origin + Vec2(i, j) * t.cell; }
+  /// The nearest node to (x, y), clamped to the raster.
+  std::size_t nearest(double x, double y) const {
+    const int i =
+        std::clamp(static_cast<int>(std::lround((x - t.origin.x()) / t.cell)), 0, t.nx - 1);
+    const int j =
+        std::clamp(static_cast<int>(std::lround((y - t.origin.y()) / t.cell)), 0, t.ny - 1);
+    return index(i, j);
+  }
+  /// Calls f(i, j, z) for every node inside triangle abc seen from above, z its plane's height
+  /// there (vertical triangles cover no node).
+  template <class F>
+  void covered(const Vec3& a, const Vec3& b, const Vec3& c, F&& f) const {
+    const double d = (b.x() - a.x()) * (c.y() - a.y()) - (c.x() - a.x()) * (b.y() - a.y());
+    if (d == 0) return;
+    const Vec2 lo = (a.head<2>().cwiseMin(b.head<2>()).cwiseMin(c.head<2>()) - t.origin) / t.cell;
+    const Vec2 hi = (a.head<2>().cwiseMax(b.head<2>()).cwiseMax(c.head<2>()) - t.origin) / t.cell;
+    const int i0 = std::max(0, static_cast<int>(std::ceil(lo.x())));
+    const int i1 = std::min(t.nx - 1, static_cast<int>(std::floor(hi.x())));
+    const int j0 = std::max(0, static_cast<int>(std::ceil(lo.y())));
+    const int j1 = std::min(t.ny - 1, static_cast<int>(std::floor(hi.y())));
+    for (int i = i0; i <= i1; ++i)
+      for (int j = j0; j <= j1; ++j) {
+        const Vec2 q = node(i, j);
+        const double u =
+            ((q.x() - a.x()) * (c.y() - a.y()) - (c.x() - a.x()) * (q.y() - a.y())) / d;
+        const double v =
+            ((b.x() - a.x()) * (q.y() - a.y()) - (q.x() - a.x()) * (b.y() - a.y())) / d;
+        if (u < -1e-9 || v < -1e-9 || u + v > 1 + 1e-9) continue;
+        f(i, j, a.z() + u * (b.z() - a.z()) + v * (c.z() - a.z()));
+      }
+  }
+};
+
+// The nodes where the part stands above H: nodes inside a triangle (from above) whose plane is
+// higher there, and the nearest node to any point of a triangle's edges (every half cell) that
+// is, which catches walls and slivers that cover no node. `first` gets such a point.
+std::vector<char> stands_above(const TriangleMesh& mesh, const std::vector<char>& in_patch,
+                               const Raster& r, Vec3* first) {
+  const FacetedTop& H = r.t;
+  std::vector<char> above(static_cast<std::size_t>(H.nx) * H.ny, 0);
+  bool found = false;
+  auto mark = [&](std::size_t q, const Vec3& p) {
+    above[q] = 1;
+    if (!found) found = true, *first = p;
+  };
+  for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
+    if (in_patch[f]) continue;
+    const auto& F = mesh.faces[f];
+    const Vec3 v[3] = {mesh.vertices[F[0]], mesh.vertices[F[1]], mesh.vertices[F[2]]};
+    r.covered(v[0], v[1], v[2], [&](int i, int j, double z) {
+      const std::size_t q = r.index(i, j);
+      if (z > H.h[q] + kAbove) mark(q, Vec3(r.node(i, j).x(), r.node(i, j).y(), z));
+    });
+    for (int k = 0; k < 3; ++k) {
+      const Vec3 &A = v[k], &B = v[(k + 1) % 3];
+      const int n = 1 + static_cast<int>((B - A).head<2>().norm() / (0.5 * H.cell));
+      for (int s = 0; s <= n; ++s) {
+        const Vec3 q = A + (B - A) * (static_cast<double>(s) / n);
+        if (q.z() > H.height(q.x(), q.y()) + kAbove) mark(r.nearest(q.x(), q.y()), q);
+      }
+    }
+  }
+  return above;
+}
+
+// Chamfer distance (mm) from every node to the nearest marked one, two passes with steps of
+// one cell and a diagonal; +inf where nothing is marked.
+std::vector<double> distance_to(const std::vector<char>& marked, const Raster& r) {
+  const FacetedTop& t = r.t;
+  std::vector<double> d(marked.size(), std::numeric_limits<double>::infinity());
+  for (std::size_t q = 0; q < marked.size(); ++q)
+    if (marked[q]) d[q] = 0;
+  const double s = t.cell, sd = t.cell * M_SQRT2;
+  auto relax = [&](int i, int j, int di, int dj, double w) {
+    const int i2 = i + di, j2 = j + dj;
+    if (i2 < 0 || j2 < 0 || i2 >= t.nx || j2 >= t.ny) return;
+    double& here = d[r.index(i, j)];
+    here = std::min(here, d[r.index(i2, j2)] + w);
+  };
+  for (int i = 0; i < t.nx; ++i)
+    for (int j = 0; j < t.ny; ++j) {
+      relax(i, j, -1, 0, s), relax(i, j, 0, -1, s);
+      relax(i, j, -1, -1, sd), relax(i, j, -1, 1, sd);
+    }
+  for (int i = t.nx - 1; i >= 0; --i)
+    for (int j = t.ny - 1; j >= 0; --j) {
+      relax(i, j, 1, 0, s), relax(i, j, 0, 1, s);
+      relax(i, j, 1, 1, sd), relax(i, j, 1, -1, sd);
+    }
+  return d;
+}
+
+}  // namespace
+
+ShellRegion shell_region(const TriangleMesh& mesh, const std::vector<char>& in_patch,
+                         const FacetedTop& top, const LayerParams& p) {
+  ShellRegion out;
+  const Raster r{top};
+  Vec3 first{0, 0, 0};
+  std::vector<char> above = stands_above(mesh, in_patch, r, &first);
+  if (std::find(above.begin(), above.end(), 1) == above.end()) return out;  // R: everywhere
+  // R shrinks by a node at its edge: the edges' points were marked at their nearest node only.
+  std::vector<char> grown = above;
+  for (int i = 0; i < top.nx; ++i)
+    for (int j = 0; j < top.ny; ++j)
+      if (above[r.index(i, j)])
+        for (int di = -1; di <= 1; ++di)
+          for (int dj = -1; dj <= 1; ++dj) {
+            const int i2 = i + di, j2 = j + dj;
+            if (i2 >= 0 && j2 >= 0 && i2 < top.nx && j2 < top.ny) grown[r.index(i2, j2)] = 1;
+          }
+  out.mask = top;
+  for (std::size_t q = 0; q < grown.size(); ++q) out.mask.h[q] = grown[q] ? -1.0 : 1.0;
+
+  // The patch's nodes: most of them must be in R, and each bounds z_ins by its distance to
+  // what stands above.
+  std::vector<char> patch_node(above.size(), 0);
+  for (std::size_t f = 0; f < mesh.faces.size(); ++f)
+    if (in_patch[f]) {
+      const auto& F = mesh.faces[f];
+      r.covered(mesh.vertices[F[0]], mesh.vertices[F[1]], mesh.vertices[F[2]],
+                [&](int i, int j, double) { patch_node[r.index(i, j)] = 1; });
+    }
+  std::size_t on_patch = 0, in_r = 0;
+  for (std::size_t q = 0; q < above.size(); ++q)
+    if (patch_node[q]) ++on_patch, in_r += !grown[q];
+  if (on_patch == 0 || 2 * in_r < on_patch) {
+    out.refused = at("the part stands above most of the curved top", first);
+    return out;
+  }
+  const std::vector<double> dist = distance_to(above, r);
+  const HeadClearance head(p.toolhead);
+  // a(d) at its lowest round the nozzle (a shaped head is not round), by distance in cells.
+  std::vector<double> allowance;
+  auto allow = [&](double d) {
+    const auto k = static_cast<std::size_t>(d / top.cell);
+    while (allowance.size() <= k) {
+      const double dk = static_cast<double>(allowance.size()) * top.cell;
+      double a = std::numeric_limits<double>::infinity();
+      for (int s = 0; s < 16; ++s)
+        a = std::min(a, head.allowance(dk * Vec2(std::cos(s * M_PI / 8), std::sin(s * M_PI / 8))));
+      allowance.push_back(a);
+    }
+    return allowance[k];
+  };
+  const double margin = 0.25 * p.layer_height;
+  Vec3 lo_at{0, 0, 0}, hi_at{0, 0, 0};
+  for (int i = 0; i < top.nx; ++i)
+    for (int j = 0; j < top.ny; ++j) {
+      const std::size_t q = r.index(i, j);
+      if (!patch_node[q] || grown[q] || !(dist[q] <= head.reach())) continue;
+      const double a = allow(dist[q]);
+      if (!std::isfinite(a)) continue;
+      const Vec3 here(r.node(i, j).x(), r.node(i, j).y(), top.h[q]);
+      if (top.h[q] - a - margin > out.z_lo) out.z_lo = top.h[q] - a - margin, lo_at = here;
+      if (top.h[q] + a + margin < out.z_hi) out.z_hi = top.h[q] + a + margin, hi_at = here;
+    }
+  if (out.z_lo > out.z_hi) {
+    char buf[320];
+    std::snprintf(buf, sizeof buf,
+                  "the part stands above the curved top near (%.2f, %.2f), and the shell there "
+                  "would have to print before it (its top at %.2f mm) and after it (at (%.2f, "
+                  "%.2f) its top is %.2f mm)",
+                  hi_at.x(), hi_at.y(), hi_at.z(), lo_at.x(), lo_at.y(), lo_at.z());
+    out.refused = buf;
+  }
+  return out;
+}
+
+}  // namespace nonplanar::layers
