@@ -100,7 +100,7 @@ ShellPlan plan_shell(const TriangleMesh& mesh, const Analysis& a, const std::vec
   // under the shell.
   std::vector<char> in_patch(mesh.faces.size(), 0);
   for (int f : P.faces) in_patch[static_cast<std::size_t>(f)] = 1;
-  ShellRegion region = shell_region(mesh, in_patch, s.top, p);
+  ShellRegion region = shell_region(mesh, in_patch, s.top, (s.N - 1) * s.t, p);
   if (!region.refused.empty()) {
     s.refused = region.refused;
     return s;

@@ -115,7 +115,7 @@ std::vector<double> distance_to(const std::vector<char>& marked, const Raster& r
 }  // namespace
 
 ShellRegion shell_region(const TriangleMesh& mesh, const std::vector<char>& in_patch,
-                         const FacetedTop& top, const LayerParams& p) {
+                         const FacetedTop& top, double lowest, const LayerParams& p) {
   ShellRegion out;
   const Raster r{top};
   Vec3 first{0, 0, 0};
@@ -175,14 +175,16 @@ ShellRegion shell_region(const TriangleMesh& mesh, const std::vector<char>& in_p
       if (!std::isfinite(a)) continue;
       const Vec3 here(r.node(i, j).x(), r.node(i, j).y(), top.h[q]);
       if (top.h[q] - a - margin > out.z_lo) out.z_lo = top.h[q] - a - margin, lo_at = here;
-      if (top.h[q] + a + margin < out.z_hi) out.z_hi = top.h[q] + a + margin, hi_at = here;
+      const double u0 = top.h[q] - lowest;  // the shell's lowest nozzle height here
+      if (u0 + a + margin < out.z_hi) out.z_hi = u0 + a + margin, hi_at = here;
     }
   if (out.z_lo > out.z_hi) {
     char buf[320];
     std::snprintf(buf, sizeof buf,
-                  "the part stands above the curved top near (%.2f, %.2f), and the shell there "
-                  "would have to print before it (its top at %.2f mm) and after it (at (%.2f, "
-                  "%.2f) its top is %.2f mm)",
+                  "the part stands above the curved top, and no one moment in the print order "
+                  "suits the shell beside it both near (%.2f, %.2f), where the top is at %.2f "
+                  "mm, and near (%.2f, %.2f), at %.2f mm (nothing may stand above a shell within "
+                  "about a millimetre of it)",
                   hi_at.x(), hi_at.y(), hi_at.z(), lo_at.x(), lo_at.y(), lo_at.z());
     out.refused = buf;
   }

@@ -10,11 +10,17 @@
 // of every later layer that lies outside R.
 //
 // Why one z_ins works: material outside R printed before the shell stands at most z_ins, and
-// the nozzle on the shell at p is at H(p); material outside R printed after it starts above
-// z_ins. So within a(d) of the material outside R, |H(p) − z_ins| ≤ a(d) + h/4 (the check's
-// collision is a rise of more than h/2 over a(d)) keeps both sides clear: along a wall that
-// rises from the patch, its foot must be level to about a layer, and farther away the cone
-// gives room. When no z_ins fits every p, the shell is refused and the gate never sees it.
+// the nozzle on the shell at p is at U_0(p) = H(p) − (N − 1)·t at its lowest (the shell's
+// lowest layer); material outside R printed after it starts above z_ins, and the shell under p
+// reaches H(p). So within a(d) of the material outside R,
+//   H(p) − a(d) − h/4 ≤ z_ins ≤ U_0(p) + a(d) + h/4
+// (the check's collision is a rise of more than h/2 over a(d)). Both hold only where
+// 2·a(d) + h/2 ≥ (N − 1)·t: nothing may stand above the shell within about a millimetre of it
+// (0.6 mm with a 45° cone and 0.2 mm layers, from the beads' centres), and beyond that the
+// foot of what stands above must be about level. When no z_ins fits every p, the shell is
+// refused and the gate never sees it. (Letting R give up the nodes that break this does not
+// work: a node left out is printed planar to the top's own height beside the shell, which is
+// again material standing above the shell's lower layers within a millimetre, and so on.)
 #pragma once
 
 #include <limits>
@@ -40,8 +46,9 @@ struct ShellRegion {
 };
 
 /// Inputs: the placed mesh, whether each face is one of the shell's patches (size = faces),
-/// H, and the printer's layer height and head. Output: R and z_ins's interval, or `refused`.
+/// H, how far the shell's lowest layer's top lies under H ((N − 1)·t, mm), and the printer's
+/// layer height and head. Output: R and z_ins's interval, or `refused`.
 ShellRegion shell_region(const TriangleMesh& mesh, const std::vector<char>& in_patch,
-                         const FacetedTop& top, const LayerParams& p);
+                         const FacetedTop& top, double lowest, const LayerParams& p);
 
 }  // namespace nonplanar::layers
