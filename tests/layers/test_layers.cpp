@@ -7,6 +7,7 @@
 #include "core/mesh_topology.hpp"
 #include "layers/stack_builder.hpp"
 #include "nonplanar/deform.hpp"
+#include "nonplanar/io.hpp"
 #include "nonplanar/layers.hpp"
 #include "support/geometry.hpp"
 #include "support/solids.hpp"
@@ -157,6 +158,30 @@ TEST(Layers, StackCacheGivesTheSamePlanWithFewerPatches) {
   EXPECT_FALSE(both->field->planar_at(out.x(), out.y()));
 }
 
+// FoilCutter's fit swings off its patch, where its layers broke the limits with penalties no
+// move of the free layers could lift (a cost of 2.6e9 at the start): the optimiser ran its
+// 100 iterations, bent the layers over the patch, and its result was thrown away. The limits
+// now count over the patch, as the stack's figures do; the even start meets them there and is
+// the optimum, so the optimiser stops at once.
+TEST(Layers, OptimiserLeavesAnEvenStackThatMeetsTheLimitsOnItsPatch) {
+  const auto dir = test::shared_models();
+  if (dir.empty()) GTEST_SKIP() << "../shared/models not present";
+  auto m = load_mesh(dir / "np_curvislicer_FoilCutter.stl", {}, {});
+  ASSERT_TRUE(m);
+  const Analysis a = *analyze(m->mesh, {}, {});
+  ASSERT_FALSE(a.patches.empty());
+  const auto fit = fit_patch(m->mesh, a.patches[0], {}, {});
+  ASSERT_TRUE(fit);
+  const ColumnCaster cols(m->mesh);
+  const LayerParams lp;
+  const layers::PlanarLayers planar{lp.first_layer_height, lp.layer_height};
+  const auto r = layers::build_stack(m->mesh, a.patches[0], 0, fit->surface, cols, lp, planar);
+  ASSERT_TRUE(r.failure.empty()) << r.failure;
+  EXPECT_LE(r.stack.iterations, 1);
+  EXPECT_LT(r.stack.cost_before, 1e3);
+  EXPECT_EQ(r.stack.optimizer_message.find("kept"), std::string::npos);
+}
+
 TEST(Layers, OptimiserLowersTheCostOfAPoorStart) {
   const TriangleMesh m = test::sine_roof();
   const Analysis a = *analyze(m, {}, {});
@@ -183,7 +208,9 @@ TEST(Layers, OptimiserLowersTheCostOfAPoorStart) {
   // The even interpolation is a stationary point of eq. (1): nothing to improve there.
   const auto even = layers::build_stack(m, a.patches[0], 0, fit->surface, cols, lp, planar, 1.0);
   EXPECT_NEAR(even.stack.cost_after, even.stack.cost_before, 1e-9 * even.stack.cost_before);
-  EXPECT_LE(r.stack.cost_after, even.stack.cost_before * 1.01);
+  // From the poor start it ends near that optimum: 72.3 against 70.5, 2.5 % over (with the
+  // penalties off the patch counted too, both were larger and within 1 % of each other).
+  EXPECT_LE(r.stack.cost_after, even.stack.cost_before * 1.03);
   // Cancelled (Ctrl-C, --max-time): the optimiser stops at its first iteration's end.
   std::atomic<bool> stop{true};
   Context cancelled;
