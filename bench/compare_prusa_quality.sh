@@ -2,9 +2,9 @@
 # The quality figures of DESIGN.md §4 for nonplanar's non-planar slice and PrusaSlicer's
 # planar one, side by side, measured by `nonplanar check` on both G-code files.
 # Usage: bench/compare_prusa_quality.sh [MODEL...]
-# Default models: the end-to-end issue's analytic solids (written by build/bench/
-# make_test_solids), the shared curved models (wing, FoilCutter, sphere) and
-# examples/wave_roof.stl. Same print both ways: 0.2 mm layers, 0.4 mm nozzle, max_angle 30°.
+# Default models: the end-to-end and coverage issues' analytic solids (written by build/bench/
+# make_test_solids), the shared curved models (wing, FoilCutter, sphere),
+# examples/wave_roof.stl and three shared real parts (ankle base, car, airfoil). Same print both ways: 0.2 mm layers, 0.4 mm nozzle, max_angle 30°.
 # Installs prusa-slicer through scripts/setup.sh if needed, and builds.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -15,9 +15,12 @@ models=("$@")
 if ((${#models[@]} == 0)); then
   ./build/bench/make_test_solids "$tmp/solids"
   models=("$tmp"/solids/saddle.stl "$tmp"/solids/sine_roof.stl "$tmp"/solids/domed_towers.stl
-          "$tmp"/solids/dome_cut_by_box.stl "$tmp"/solids/rib.stl ../shared/models/np_curvislicer_wing.stl
+          "$tmp"/solids/dome_cut_by_box.stl "$tmp"/solids/rib.stl "$tmp"/solids/rib_beside_tower.stl
+          "$tmp"/solids/hollow_roof_1.5mm.stl "$tmp"/solids/hollow_roof_0.8mm.stl
+          ../shared/models/np_curvislicer_wing.stl
           ../shared/models/np_curvislicer_FoilCutter.stl ../shared/models/np_prusa_sphere.stl
-          examples/wave_roof.stl)
+          examples/wave_roof.stl ../shared/models/np_curvislicer_anklebase_small.stl
+          ../shared/models/np_curvislicer_car_med.stl ../shared/models/np_curvislicer_airfoil.stl)
 fi
 common=(--layer-height 0.2 --first-layer-height 0.2 --perimeters 2 --top-solid-layers 5
         --bottom-solid-layers 4 --fill-density 20% --fill-pattern rectilinear --skirts 1
@@ -25,16 +28,21 @@ common=(--layer-height 0.2 --first-layer-height 0.2 --perimeters 2 --top-solid-l
 # One row per slicer: deviation p95 / mean / max (mm), thickness min-max (mm), steepest (deg),
 # collisions; nonplanar's rows also say how many curved stacks (or shells) it printed: with its
 # built-in planar engine, and with PrusaSlicer as the engine (--engine prusaslicer).
+# "curved": the share of the curved top's samples (facets 2-30 deg) within 0.03 mm (#19).
 figures() {
+  local curved
+  curved=$(./build/nonplanar check -q --json "$1" --mesh "$2" --min-angle 2 |
+    python3 -c 'import json, sys; print("%6.3f" % json.load(sys.stdin)["top_surface_deviation"]["within_share"])')
   ./build/nonplanar check -q --json "$1" --mesh "$2" | python3 -c '
 import json, sys
 j = json.load(sys.stdin)
 d = j["top_surface_deviation"]
 print("%7.4f %7.4f %7.4f  %5.3f-%5.3f %6.1f %6d" % (d["p95"], d["mean"], d["max"],
-      j["thickness_min"], j["thickness_max"], j["steepest_extrusion"], j["collisions"]))'
+      j["thickness_min"], j["thickness_max"], j["steepest_extrusion"], j["collisions"]), end="")'
+  echo " $curved"
 }
-printf "%-34s %-11s %7s %7s %7s  %-11s %6s %6s  %s\n" model slicer p95 mean max thickness steep coll \
-  "curved stacks/shells"
+printf "%-34s %-11s %7s %7s %7s  %-11s %6s %6s %6s  %s\n" model slicer p95 mean max thickness steep coll \
+  curved "curved stacks/shells"
 for m in "${models[@]}"; do
   name=$(basename "$m")
   ./build/nonplanar slice -q "$m" -o "$tmp/np.gcode" "${common[@]}"

@@ -1,5 +1,6 @@
-// make_test_solids DIR: write the end-to-end issue's analytic solids (tests/support/solids.hpp)
-// as binary STL, for scripts that slice them with nonplanar and PrusaSlicer.
+// make_test_solids DIR: write the end-to-end and coverage issues' analytic solids
+// (tests/support/solids.hpp) as binary STL, for scripts that slice them with nonplanar and
+// PrusaSlicer.
 #include <cstdio>
 #include <filesystem>
 #include <utility>
@@ -21,7 +22,10 @@ int main(int argc, char** argv) {
       {"sine_roof.stl", t::sine_roof()},
       {"domed_towers.stl", t::domed_towers()},
       {"dome_cut_by_box.stl", t::dome_cut_by_box()},
-      {"rib.stl", t::rib()}};
+      {"rib.stl", t::rib()},
+      {"rib_beside_tower.stl", t::rib_beside_tower()},
+      {"hollow_roof_1.5mm.stl", t::hollow_roof(1.5)},
+      {"hollow_roof_0.8mm.stl", t::hollow_roof(0.8)}};
   for (const auto& [name, mesh] : solids) {
     auto w = nonplanar::write_stl(dir / name, mesh);
     if (!w) {

@@ -37,6 +37,35 @@ std::vector<double> core_boundaries(double h1, double h_c, double h_min, double 
   return z;
 }
 
+// An overhang or another printable up-facing surface (not of the patches) within `overhang`
+// (overhangs) or half a millimetre (tops) under the shell's bottom, inside R: why the shell
+// cannot rest on the core there, naming the place; empty when none.
+std::string under_shell(const TriangleMesh& mesh, const std::vector<char>& in_patch,
+                        const ShellPlan& s, double max_angle_deg, double overhang) {
+  const double cos_max = std::cos(max_angle_deg * kDeg);
+  for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
+    if (in_patch[f]) continue;
+    const auto& F = mesh.faces[f];
+    const Vec3 v[3] = {mesh.vertices[F[0]], mesh.vertices[F[1]], mesh.vertices[F[2]]};
+    const Vec3 nrm = (v[1] - v[0]).cross(v[2] - v[0]);
+    const double len = nrm.norm();
+    if (!(len > 0)) continue;
+    const double nz = nrm.z() / len;
+    const bool on_bed = std::max({v[0].z(), v[1].z(), v[2].z()}) < 1e-6;
+    const bool is_overhang = nz < -0.1 && !on_bed;
+    const bool printable_top = nz > cos_max;
+    if (!is_overhang && !printable_top) continue;
+    const double margin = is_overhang ? overhang : 0.5;
+    const Vec3 c = (v[0] + v[1] + v[2]) / 3.0;
+    for (const Vec3& q : {v[0], v[1], v[2], c})
+      if (s.in_region(q.x(), q.y()) && q.z() > s.bottom(q.x(), q.y()) - margin)
+        return at(is_overhang ? "an overhang lies under the shell"
+                              : "another printable surface lies under the shell",
+                  q);
+  }
+  return {};
+}
+
 }  // namespace
 
 double ShellPlan::core_top(double x, double y) const {
@@ -96,37 +125,34 @@ ShellPlan plan_shell(const TriangleMesh& mesh, const Analysis& a, const std::vec
   s.top = faceted_top(mesh, P, 0.1, pad, std::tan(0.8 * p.max_angle_deg * kDeg) / M_SQRT2);
 
   // Where the part stands above H, the shell prints only in R (shell_region.hpp). Inside R,
-  // no overhang and no other printable up-facing surface may lie within half a millimetre
-  // under the shell.
+  // no other printable up-facing surface may lie within half a millimetre under the shell,
+  // nor an overhang (a hollow part's ceiling). Over a wall thinner than that (0.8 mm under a
+  // hollow roof) the shell takes fewer layers, down to one: the core still stands under it
+  // wherever a core layer fits between the ceiling and B + a (overhang margin, `thin`).
   std::vector<char> in_patch(mesh.faces.size(), 0);
   for (int f : P.faces) in_patch[static_cast<std::size_t>(f)] = 1;
-  ShellRegion region = shell_region(mesh, in_patch, s.top, (s.N - 1) * s.t, p);
-  if (!region.refused.empty()) {
-    s.refused = region.refused;
-    return s;
-  }
-  s.region = std::move(region.mask);
-  const double cos_max = std::cos(p.max_angle_deg * kDeg);
-  for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
-    if (in_patch[f]) continue;
-    const auto& F = mesh.faces[f];
-    const Vec3 v[3] = {mesh.vertices[F[0]], mesh.vertices[F[1]], mesh.vertices[F[2]]};
-    const Vec3 nrm = (v[1] - v[0]).cross(v[2] - v[0]);
-    const double len = nrm.norm();
-    if (!(len > 0)) continue;
-    const double nz = nrm.z() / len;
-    const bool on_bed = std::max({v[0].z(), v[1].z(), v[2].z()}) < 1e-6;
-    const bool overhang = nz < -0.1 && !on_bed;
-    const bool printable_top = nz > cos_max;
-    if (!overhang && !printable_top) continue;
-    const Vec3 c = (v[0] + v[1] + v[2]) / 3.0;
-    for (const Vec3& q : {v[0], v[1], v[2], c})
-      if (s.in_region(q.x(), q.y()) && q.z() > s.bottom(q.x(), q.y()) - 0.5) {
-        s.refused = at(overhang ? "an overhang lies under the shell"
-                                : "another printable surface lies under the shell",
-                       q);
-        return s;
+  const int N0 = s.N;
+  const double thin = 1.5 * h_c - s.reach + 0.05;
+  std::pair<double, double> region_z{0, 0};  // z_ins's interval
+  std::string first_refusal;
+  for (int N = N0; N >= 1; --N) {
+    s.N = N;
+    ShellRegion region = shell_region(mesh, in_patch, s.top, (N - 1) * s.t, p);
+    std::string why = region.refused;
+    if (why.empty()) {
+      s.region = std::move(region.mask);
+      s.insert_z = std::numeric_limits<double>::infinity();
+      why = under_shell(mesh, in_patch, s, p.max_angle_deg, N == N0 ? 0.5 : thin);
+      if (why.empty()) {
+        region_z = {region.z_lo, region.z_hi};
+        break;
       }
+    }
+    if (first_refusal.empty()) first_refusal = why;
+    if (N == 1) {
+      s.refused = first_refusal;
+      return s;
+    }
   }
 
   // The core: up to the highest B + a, landing on the flat patches' heights.
@@ -140,19 +166,19 @@ ShellPlan plan_shell(const TriangleMesh& mesh, const Analysis& a, const std::vec
   if (!s.region.empty()) end = box.max.z();          // the part outside R goes on above the shell
   s.core =
       core_boundaries(std::min(p.first_layer_height, h_c), h_c, p.min_layer_height, end, targets);
-  if (!s.region.empty() && std::isfinite(region.z_lo + region.z_hi)) {
+  if (!s.region.empty() && std::isfinite(region_z.first + region_z.second)) {
     // The core boundary nearest the middle of z_ins's interval.
-    const double mid = 0.5 * (region.z_lo + region.z_hi);
+    const double mid = 0.5 * (region_z.first + region_z.second);
     double best = std::numeric_limits<double>::infinity();
     for (double z : s.core)
-      if (z >= region.z_lo && z <= region.z_hi && std::abs(z - mid) < std::abs(best - mid))
+      if (z >= region_z.first && z <= region_z.second && std::abs(z - mid) < std::abs(best - mid))
         best = z;
     if (!std::isfinite(best)) {
       char buf[200];
       std::snprintf(buf, sizeof buf,
                     "the part stands above the curved top, and no core layer ends between z = "
                     "%.2f and %.2f mm, where the shell would have to print",
-                    region.z_lo, region.z_hi);
+                    region_z.first, region_z.second);
       s.refused = buf;
       return s;
     }

@@ -91,11 +91,25 @@ TEST(ShellPlan, RefusesWhatTheShellCannotCover) {
   test::append(tower, test::box({30, 12, 0}, {40, 16, 14}));
   const std::string stands = plan(tower).refused;
   EXPECT_NE(stands.find("the part stands above the curved top"), std::string::npos) << stands;
-  // A void whose ceiling is 0.3 mm under the shell's bottom at x = 20 (B = 6.55 mm).
+  // A void whose ceiling is 0.25 mm under the top at x = 20 (H = 7.35 mm): no core layer fits
+  // between it and even a one-layer shell.
   TriangleMesh hollow = test::rib();
-  test::append(hollow, void_box({20, 3, 5}, {40, 9, 6.25}));
+  test::append(hollow, void_box({20, 3, 5}, {40, 9, 7.1}));
   const std::string why = plan(hollow).refused;
   EXPECT_NE(why.find("overhang lies under the shell"), std::string::npos) << why;
+}
+
+// A void whose ceiling is 0.3 mm under the four-layer shell's bottom at x = 20 (B = 6.55 mm,
+// ceiling 6.25 mm): the shell takes three layers, whose bottom (6.75 mm) leaves room for a core
+// layer between it and the ceiling (1.5 h_c − a + 0.05 = 0.23 mm at the defaults).
+TEST(ShellPlan, TakesFewerLayersOverAThinWall) {
+  TriangleMesh hollow = test::rib();
+  test::append(hollow, void_box({20, 3, 5}, {40, 9, 6.25}));
+  const layers::ShellPlan s = plan(hollow);
+  ASSERT_TRUE(s.refused.empty()) << s.refused;
+  EXPECT_EQ(s.N, 3);
+  EXPECT_EQ(plan(test::rib()).N, 4);
+  EXPECT_GE(s.bottom(20, 6) - 6.25, 0.23 - 1e-6);
 }
 
 }  // namespace

@@ -152,4 +152,21 @@ TriangleMesh rib() {
                             80, 0, 12, 160, 12);
 }
 
+TriangleMesh rib_beside_tower() {
+  TriangleMesh m = rib();
+  append(m, box({82, 4, 0}, {86, 8, 14}));
+  return m;
+}
+
+TriangleMesh hollow_roof(double wall) {
+  auto roof = [](double x, double y) { return 6 + 2.5 * std::sin(x / 7) * std::cos(y / 9); };
+  TriangleMesh m = height_field_solid(roof, 0, 40, 0, 40, 80, 80);
+  const int n = static_cast<int>(std::lround((40 - 2 * wall) / 0.5));
+  TriangleMesh hole = height_field_solid([&](double x, double y) { return roof(x, y) - wall; },
+                                         wall, 40 - wall, wall, 40 - wall, n, n, wall);
+  for (auto& f : hole.faces) std::swap(f[1], f[2]);  // a void: inside out
+  append(m, hole);
+  return m;
+}
+
 }  // namespace nonplanar::test

@@ -48,6 +48,12 @@ TriangleMesh dome_cut_by_box();
 /// and falls to 7.35 mm at its tail, 0.3 + 12 sin(πx / 100) (at most 20.7° steep). No stack
 /// over a plane can follow it: its layer count would have to change 40-fold along it.
 TriangleMesh rib();
+/// rib beside a tower: the rib with a 4 × 4 × 14 mm tower 2 mm past its end, taller than it.
+TriangleMesh rib_beside_tower();
+/// hollow roof: 40 × 40 mm, top 6 + 2.5 sin(x / 7) cos(y / 9) (at most 21° steep), hollow
+/// inside: walls and floor `wall` mm thick, its ceiling the top lowered by `wall`. No stack fits
+/// (the part is not solid under its top); a shell must rest on the wall's top alone.
+TriangleMesh hollow_roof(double wall);
 
 /// The shared test models folder (../shared/models beside the repo); empty if absent.
 std::filesystem::path shared_models();
