@@ -1,20 +1,23 @@
+// Notation as in layers/shell_plan.hpp and layers/shell_region.hpp.
 #include "engine/shell_toolpaths.hpp"
-#include "core/parallel.hpp"
 
 #include <algorithm>
+#include <functional>
 
+#include "core/parallel.hpp"
 #include "core/polygon_ops.hpp"
 #include "layers/height_contour.hpp"
 #include "nonplanar/deform.hpp"
 
 namespace nonplanar {
+namespace {
 
-Expected<std::vector<LayerToolpaths>> shell_toolpaths(const TriangleMesh& mesh,
-                                                      const layers::ShellPlan& plan,
-                                                      const PrintConfig& print,
-                                                      const Context& ctx) {
-  // The core: planar layers at the plan's boundaries, layer k kept where z_k <= B + a, i.e.
-  // where H >= z_k − a + N·t.
+// The core: planar layers at the plan's boundaries, layer k kept where z_k <= B + a, i.e. where
+// H >= z_k − a + N·t; where the part stands above the top somewhere, cut back only inside R.
+Expected<std::vector<SlicedLayer>> core_layers(const TriangleMesh& mesh,
+                                               const layers::ShellPlan& plan,
+                                               const std::vector<ExPolygon>& R,
+                                               const Context& ctx) {
   std::vector<SlicedLayer> spans;
   for (std::size_t k = 1; k < plan.core.size(); ++k) {
     SlicedLayer l;
@@ -27,17 +30,11 @@ Expected<std::vector<LayerToolpaths>> shell_toolpaths(const TriangleMesh& mesh,
   const auto [lo_it, hi_it] = std::minmax_element(plan.top.h.begin(), plan.top.h.end());
   const double h_lo = *lo_it, h_hi = *hi_it;
   const layers::ContourIndex index(plan.top);
-  // Where the part stands above the top somewhere, the shell prints in R only: the core is cut
-  // back only there, and a layer above insert_z is split into its part in R (printed before
-  // the shell) and the rest (after it), as separate islands.
   const bool partial = !plan.region.empty();
-  const std::vector<ExPolygon> R =
-      partial ? layers::region_at_least(plan.region, 0) : std::vector<ExPolygon>{};
   core::parallel_for(std::size_t{0}, core->size(), [&](std::size_t k) {
     SlicedLayer& L = (*core)[k];
     const double level = plan.core_level(L.z_top);
-    const bool split = partial && L.z_top > plan.insert_z + 1e-9;
-    if ((level <= h_lo && !split) || L.islands.empty()) return;
+    if (level <= h_lo || L.islands.empty()) return;
     // The shell over the part cut away counts as cover for the skins below, so they are as
     // thick (shell included) as top_solid_layers asks, not that plus the shell.
     L.covers = L.islands;
@@ -46,40 +43,131 @@ Expected<std::vector<LayerToolpaths>> shell_toolpaths(const TriangleMesh& mesh,
                                : clip::intersection_ex(L.islands, index.region_at_least(level));
       return;
     }
-    const std::vector<ExPolygon> cut = level <= h_lo ? std::vector<ExPolygon>{}
-                                       : level > h_hi
-                                           ? R
-                                           : clip::diff_ex(R, index.region_at_least(level));
-    std::vector<ExPolygon> kept = cut.empty() ? L.islands : clip::diff_ex(L.islands, cut);
-    if (split) {
-      std::vector<ExPolygon> in = clip::intersection_ex(kept, R), out = clip::diff_ex(kept, R);
-      kept = std::move(in);
-      kept.insert(kept.end(), out.begin(), out.end());
-    }
-    L.islands = std::move(kept);
+    const std::vector<ExPolygon> cut =
+        level > h_hi ? R : clip::diff_ex(R, index.region_at_least(level));
+    L.islands = clip::diff_ex(L.islands, cut);
   });
   while (!core->empty() && core->back().islands.empty()) core->pop_back();
+  return core;
+}
+
+// The pieces of one shell path between the core's layer tops: `slot` of a point is how many
+// core layers are printed before it (tops[k] <= its slot level). A segment whose ends fall in
+// different slots is cut where the level crosses the top between them (by bisection).
+void split_by_slot(const ExtrusionPath& p, const layers::ShellPlan& plan,
+                   const std::vector<double>& tops,
+                   const std::function<void(int, ExtrusionPath&&)>& emit) {
+  auto slot_of = [&](const Vec3& q) {
+    const double v = plan.slot_level(q.x(), q.y(), q.z());
+    return std::max(1,
+                    static_cast<int>(std::upper_bound(tops.begin(), tops.end(), v) - tops.begin()));
+  };
+  // Segments cut to 0.2 mm first: along a long one U + s need not be monotone, and a point
+  // inside it could belong to another slot than both ends.
+  ExtrusionPath fine = p;
+  fine.points.assign(1, p.points.front()), fine.height.assign(1, p.height.front());
+  for (std::size_t i = 1; i < p.points.size(); ++i) {
+    const Vec3 &a = p.points[i - 1], &b = p.points[i];
+    const int n = 1 + static_cast<int>((b - a).head<2>().norm() / 0.2);
+    for (int k = 1; k <= n; ++k) {
+      const double f = static_cast<double>(k) / n;
+      fine.points.push_back(a + (b - a) * f);
+      fine.height.push_back(p.height[i - 1] + (p.height[i] - p.height[i - 1]) * f);
+    }
+  }
+  ExtrusionPath piece = fine;
+  piece.points.assign(1, fine.points.front()), piece.height.assign(1, fine.height.front());
+  int slot = slot_of(fine.points.front());
+  for (std::size_t i = 1; i < fine.points.size(); ++i) {
+    const Vec3 &a = fine.points[i - 1], &b = fine.points[i];
+    const double ha = fine.height[i - 1], hb = fine.height[i];
+    for (int next = slot_of(b), guard = 0; next != slot && guard < 1000; ++guard) {
+      // The crossing of the top between the two slots, on [lo, hi] along a → b.
+      const double top = tops[static_cast<std::size_t>(std::min(slot, next))];
+      double lo = 0, hi = 1;
+      const bool rising = next > slot;
+      for (int it = 0; it < 30; ++it) {
+        const double mid = 0.5 * (lo + hi);
+        const Vec3 q = a + (b - a) * mid;
+        ((plan.slot_level(q.x(), q.y(), q.z()) >= top) == rising ? hi : lo) = mid;
+      }
+      const Vec3 q = a + (b - a) * hi;
+      const double hq = ha + (hb - ha) * hi;
+      piece.points.push_back(q), piece.height.push_back(hq);
+      if (piece.points.size() >= 2) emit(slot, std::move(piece));
+      piece = fine;
+      piece.points.assign(1, q), piece.height.assign(1, hq);
+      slot = slot_of(q + (b - q) * 1e-6);
+      if (slot == next) break;
+    }
+    piece.points.push_back(b), piece.height.push_back(hb);
+  }
+  if (piece.points.size() >= 2) emit(slot, std::move(piece));
+}
+
+// Where the part stands above the top: each shell point after the core's layers up to its slot
+// level, the rest of the core after it (shell_region.hpp). Slot k holds, layer by layer in print
+// order, the pieces printed between core layers k − 1 and k (k = K: after the whole core).
+std::vector<LayerToolpaths> interleave(std::vector<LayerToolpaths> core,
+                                       const std::vector<double>& tops,
+                                       std::vector<LayerToolpaths> shell,
+                                       const layers::ShellPlan& plan) {
+  const std::size_t K = core.size();
+  std::vector<std::vector<LayerToolpaths>> slots(K + 1);
+  for (std::size_t j = 0; j < shell.size(); ++j) {
+    const LayerToolpaths& L = shell[j];
+    std::vector<LayerToolpaths*> in(K + 1, nullptr);
+    for (const ExtrusionPath& p : L.paths)
+      split_by_slot(p, plan, tops, [&](int k, ExtrusionPath&& piece) {
+        auto& s = slots[static_cast<std::size_t>(k)];
+        if (!in[static_cast<std::size_t>(k)]) {
+          LayerToolpaths part = L;
+          part.paths.clear(), part.max_z = -1e300;
+          s.push_back(std::move(part));
+          in[static_cast<std::size_t>(k)] = &s.back();
+        }
+        LayerToolpaths& part = *in[static_cast<std::size_t>(k)];
+        for (const Vec3& q : piece.points) part.max_z = std::max(part.max_z, q.z());
+        part.paths.push_back(std::move(piece));
+      });
+    // The pointers into `slots` stay valid: each slot gains one part per shell layer, and
+    // the next layer's parts are pushed only after this layer is done.
+  }
+  // A shell point printed before core layer k lies at most s⁻ (about 0.1 mm) over its top: a
+  // core layer under the highest shell point so far travels over it lifted.
+  std::vector<LayerToolpaths> out;
+  double shell_so_far = -1e300;
+  for (std::size_t k = 0; k <= K; ++k) {
+    for (LayerToolpaths& part : slots[k]) {
+      part.z = part.max_z;
+      shell_so_far = std::max(shell_so_far, part.max_z);
+      out.push_back(std::move(part));
+    }
+    if (k == K) break;
+    LayerToolpaths& L = core[k];
+    if (L.z < shell_so_far) L.nonplanar = true, L.max_z = std::max(L.max_z, shell_so_far);
+    out.push_back(std::move(L));
+  }
+  return out;
+}
+
+}  // namespace
+
+Expected<std::vector<LayerToolpaths>> shell_toolpaths(const TriangleMesh& mesh,
+                                                      const layers::ShellPlan& plan,
+                                                      const PrintConfig& print,
+                                                      const Context& ctx) {
+  const bool partial = !plan.region.empty();
+  const std::vector<ExPolygon> R =
+      partial ? layers::region_at_least(plan.region, 0) : std::vector<ExPolygon>{};
+  auto core = core_layers(mesh, plan, R, ctx);
+  if (!core) return core.error();
   ctx.progress("core", 1.0);
-  std::vector<LayerToolpaths> out, after;
+  std::vector<LayerToolpaths> core_paths;
   if (!core->empty()) {
     auto paths = make_toolpaths(*core, print.paths, ctx);
     if (!paths) return paths.error();
-    for (std::size_t k = 0; k < paths->size(); ++k) {
-      LayerToolpaths& L = (*paths)[k];
-      if (!partial || (*core)[k].z_top <= plan.insert_z + 1e-9) {
-        out.push_back(std::move(L));
-        continue;
-      }
-      LayerToolpaths in = L, rest = L;
-      in.paths.clear(), rest.paths.clear();
-      for (ExtrusionPath& p : L.paths) {
-        std::size_t inside = 0;
-        for (const Vec3& q : p.points) inside += plan.in_region(q.x(), q.y());
-        (2 * inside >= p.points.size() ? in : rest).paths.push_back(std::move(p));
-      }
-      if (!in.paths.empty()) out.push_back(std::move(in));
-      if (!rest.paths.empty()) after.push_back(std::move(rest));
-    }
+    core_paths = std::move(*paths);
   }
 
   // The shell: normalised so its layers are the planes ζ = j·t … (j + 1)·t. An empty layer
@@ -106,7 +194,7 @@ Expected<std::vector<LayerToolpaths>> shell_toolpaths(const TriangleMesh& mesh,
   planar->erase(planar->begin());
   auto mapped = map_toolpaths_back(*planar, field, {}, ctx);
   if (!mapped) return mapped.error();
-  double shell_top = 0;
+  std::vector<LayerToolpaths> shell_paths;
   for (std::size_t j = 0; j < mapped->size(); ++j) {
     LayerToolpaths& L = (*mapped)[j];
     if (L.paths.empty()) continue;
@@ -115,16 +203,16 @@ Expected<std::vector<LayerToolpaths>> shell_toolpaths(const TriangleMesh& mesh,
         p.height[k] = plan.thickness(static_cast<int>(j), p.points[k].x(), p.points[k].y());
     L.z = L.max_z;
     L.height = plan.t;
-    shell_top = std::max(shell_top, L.max_z);
-    out.push_back(std::move(L));
+    shell_paths.push_back(std::move(L));
   }
-  // The core outside R above insert_z, after the shell. Its layers below the shell's top travel
-  // over it lifted, as over a curved layer.
-  for (LayerToolpaths& L : after) {
-    if (L.z < shell_top) L.nonplanar = true, L.max_z = std::max(L.max_z, shell_top);
-    out.push_back(std::move(L));
+  if (!partial || core_paths.empty()) {
+    std::vector<LayerToolpaths> out = std::move(core_paths);
+    for (LayerToolpaths& L : shell_paths) out.push_back(std::move(L));
+    return out;
   }
-  return out;
+  std::vector<double> tops;
+  for (std::size_t k = 0; k < core_paths.size(); ++k) tops.push_back((*core)[k].z_top);
+  return interleave(std::move(core_paths), tops, std::move(shell_paths), plan);
 }
 
 }  // namespace nonplanar

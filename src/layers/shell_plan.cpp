@@ -76,8 +76,8 @@ double ShellPlan::core_top(double x, double y) const {
 
 double ShellPlan::thickness(int j, double x, double y) const {
   const double u = layer_top(j, x, y);
-  const double below = j == 0 ? core_top(x, y) : u - t;
-  return u - std::max(below, 0.0);
+  const double under = j == 0 ? core_top(x, y) : u - t;
+  return u - std::max(under, 0.0);
 }
 
 ShellPlan plan_shell(const TriangleMesh& mesh, const Analysis& a, const std::vector<int>& patches,
@@ -133,21 +133,20 @@ ShellPlan plan_shell(const TriangleMesh& mesh, const Analysis& a, const std::vec
   for (int f : P.faces) in_patch[static_cast<std::size_t>(f)] = 1;
   const int N0 = s.N;
   const double thin = 1.5 * h_c - s.reach + 0.05;
-  std::pair<double, double> region_z{0, 0};  // z_ins's interval
+  s.below = s.t - s.reach - 0.01;
+  ShellRegion region = shell_region(mesh, in_patch, s.top, s.below, p);
+  if (!region.refused.empty()) {
+    s.refused = region.refused;
+    return s;
+  }
+  s.region = std::move(region.mask);
+  s.slack = std::move(region.slack);
+  s.target = region.target;
   std::string first_refusal;
   for (int N = N0; N >= 1; --N) {
     s.N = N;
-    ShellRegion region = shell_region(mesh, in_patch, s.top, (N - 1) * s.t, p);
-    std::string why = region.refused;
-    if (why.empty()) {
-      s.region = std::move(region.mask);
-      s.insert_z = std::numeric_limits<double>::infinity();
-      why = under_shell(mesh, in_patch, s, p.max_angle_deg, N == N0 ? 0.5 : thin);
-      if (why.empty()) {
-        region_z = {region.z_lo, region.z_hi};
-        break;
-      }
-    }
+    const std::string why = under_shell(mesh, in_patch, s, p.max_angle_deg, N == N0 ? 0.5 : thin);
+    if (why.empty()) break;
     if (first_refusal.empty()) first_refusal = why;
     if (N == 1) {
       s.refused = first_refusal;
@@ -166,24 +165,6 @@ ShellPlan plan_shell(const TriangleMesh& mesh, const Analysis& a, const std::vec
   if (!s.region.empty()) end = box.max.z();          // the part outside R goes on above the shell
   s.core =
       core_boundaries(std::min(p.first_layer_height, h_c), h_c, p.min_layer_height, end, targets);
-  if (!s.region.empty() && std::isfinite(region_z.first + region_z.second)) {
-    // The core boundary nearest the middle of z_ins's interval.
-    const double mid = 0.5 * (region_z.first + region_z.second);
-    double best = std::numeric_limits<double>::infinity();
-    for (double z : s.core)
-      if (z >= region_z.first && z <= region_z.second && std::abs(z - mid) < std::abs(best - mid))
-        best = z;
-    if (!std::isfinite(best)) {
-      char buf[200];
-      std::snprintf(buf, sizeof buf,
-                    "the part stands above the curved top, and no core layer ends between z = "
-                    "%.2f and %.2f mm, where the shell would have to print",
-                    region_z.first, region_z.second);
-      s.refused = buf;
-      return s;
-    }
-    s.insert_z = best;
-  }
   return s;
 }
 

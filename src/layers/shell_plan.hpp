@@ -37,11 +37,20 @@ struct ShellPlan {
   /// Where the shell prints (shell_region.hpp): empty when the part stands nowhere above H,
   /// else +1 on R's nodes. Outside R the core prints every layer whole.
   FacetedTop region;
-  /// The core's layers with top above this print their part outside R after the shell, mm
-  /// (+inf: the whole core first, then the shell).
-  double insert_z = std::numeric_limits<double>::infinity();
+  /// s on H's raster (shell_region.hpp): a point of shell layer j at height u is printed after
+  /// the core's layers up to u + s, before the rest. Empty: after the whole core.
+  FacetedTop slack;
 
   bool in_region(double x, double y) const { return region.empty() || region.height(x, y) >= 0; }
+  /// τ (shell_region.hpp): the core's layers up to this height are printed before the shell's
+  /// point (x, y, u); +inf: all of them.
+  double slot_level(double x, double y, double u) const {
+    if (slack.empty()) return std::numeric_limits<double>::infinity();
+    const double s = slack.height(x, y);
+    return std::clamp(target, u - std::min(s, below), u + s);
+  }
+  double target = std::numeric_limits<double>::infinity();  ///< Z (shell_region.hpp), mm
+  double below = 0;                                         ///< s⁻'s bound, t − a − 0.01, mm
 
   double bottom(double x, double y) const { return top.height(x, y) - N * t; }
   /// The core's layer with top z is printed where H >= this level (z <= B + a), mm.
@@ -57,12 +66,11 @@ struct ShellPlan {
 
 /// Inputs: the placed mesh, its analysis, the patches to follow together (indices into
 /// a.patches) and the printer limits. Output: a plan, or one with `refused` set when the part
-/// stands above most of the patches or above them where no one moment in the core's order can
-/// print the shell (shell_region.hpp), another printable up-facing surface or an overhang lies
-/// inside the shell, or the limits leave no room for the stairs. Where some of the part stands
-/// above H, the shell prints only in R and at insert_z in the core's order. The core's
-/// boundaries land on every flat patch's height that they can reach in steps within
-/// [h_min, h_c].
+/// stands above most of the patches (shell_region.hpp), another printable up-facing surface or
+/// an overhang lies inside the shell, or the limits leave no room for the stairs. Where some of
+/// the part stands above H, the shell prints only in R, its points interleaved with the core's
+/// layers by slot_level. The core's boundaries land on every flat patch's height that they can
+/// reach in steps within [h_min, h_c].
 ShellPlan plan_shell(const TriangleMesh& mesh, const Analysis& a, const std::vector<int>& patches,
                      const LayerParams& p);
 

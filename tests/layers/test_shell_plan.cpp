@@ -85,18 +85,40 @@ TEST(ShellPlan, CoreLandsOnAFlatFloorInside) {
 }
 
 TEST(ShellPlan, RefusesWhatTheShellCannotCover) {
-  // A tower against the rib's side, where the rib's top runs from 10.0 to 11.7 mm along its
-  // foot: the shell beside it would have to print both before and after it.
-  TriangleMesh tower = test::rib();
-  test::append(tower, test::box({30, 12, 0}, {40, 16, 14}));
-  const std::string stands = plan(tower).refused;
-  EXPECT_NE(stands.find("the part stands above the curved top"), std::string::npos) << stands;
+  // A slab over the whole rib: nothing of its top is left to print curved.
+  TriangleMesh covered = test::rib();
+  test::append(covered, test::box({-1, -1, 13}, {81, 13, 14}));
+  const std::string stands = plan(covered).refused;
+  EXPECT_NE(stands.find("the part stands above most of the curved top"), std::string::npos)
+      << stands;
   // A void whose ceiling is 0.25 mm under the top at x = 20 (H = 7.35 mm): no core layer fits
   // between it and even a one-layer shell.
   TriangleMesh hollow = test::rib();
   test::append(hollow, void_box({20, 3, 5}, {40, 9, 7.1}));
   const std::string why = plan(hollow).refused;
   EXPECT_NE(why.find("overhang lies under the shell"), std::string::npos) << why;
+}
+
+// A tower against the rib's side (x 30-40), where the rib's top runs from 10.0 to 11.7 mm
+// along its foot: the shell prints where nothing stands above it, and next to the tower its
+// points may be printed no more than the head allows before or after the tower's layers there
+// (the slack s: the cone's allowance, grown no faster than 0.15 mm per mm, + h/4).
+TEST(ShellPlan, BesideATowerPrintsWhereNothingStandsAboveWithALittleSlack) {
+  TriangleMesh tower = test::rib();
+  test::append(tower, test::box({30, 12, 0}, {40, 16, 14}));
+  const layers::ShellPlan s = plan(tower);
+  ASSERT_TRUE(s.refused.empty()) << s.refused;
+  ASSERT_FALSE(s.region.empty());
+  EXPECT_FALSE(s.in_region(35, 14));  // the tower
+  EXPECT_TRUE(s.in_region(35, 6));
+  EXPECT_TRUE(s.in_region(70, 6));
+  // Slack 0.05 mm (h/4) at the tower's foot, growing no faster than 0.15 mm per mm.
+  EXPECT_NEAR(s.slack.height(35, 11.9), 0.05, 0.03);
+  EXPECT_LE(s.slack.height(35, 6), 0.05 + 0.15 * 6 + 0.03);
+  EXPECT_GT(s.slack.height(35, 6), s.slack.height(35, 11));
+  // So a point next to it is printed close to its own height, one far off at the target.
+  const double u = s.top.height(35, 11.8);
+  EXPECT_NEAR(s.slot_level(35, 11.8, u), u, 0.1);
 }
 
 // A void whose ceiling is 0.3 mm under the four-layer shell's bottom at x = 20 (B = 6.55 mm,

@@ -158,6 +158,12 @@ TriangleMesh rib_beside_tower() {
   return m;
 }
 
+TriangleMesh rib_against_tower() {
+  TriangleMesh m = rib();
+  append(m, box({30, 12, 0}, {40, 16, 14}));
+  return m;
+}
+
 TriangleMesh hollow_roof(double wall) {
   auto roof = [](double x, double y) { return 6 + 2.5 * std::sin(x / 7) * std::cos(y / 9); };
   TriangleMesh m = height_field_solid(roof, 0, 40, 0, 40, 80, 80);

@@ -50,6 +50,8 @@ TriangleMesh dome_cut_by_box();
 TriangleMesh rib();
 /// rib beside a tower: the rib with a 4 × 4 × 14 mm tower 2 mm past its end, taller than it.
 TriangleMesh rib_beside_tower();
+/// rib against a tower: the rib with a 10 × 4 × 14 mm tower against its side (x 30-40).
+TriangleMesh rib_against_tower();
 /// hollow roof: 40 × 40 mm, top 6 + 2.5 sin(x / 7) cos(y / 9) (at most 21° steep), hollow
 /// inside: walls and floor `wall` mm thick, its ceiling the top lowered by `wall`. No stack fits
 /// (the part is not solid under its top); a shell must rest on the wall's top alone.
