@@ -117,6 +117,60 @@ std::vector<double> distance_to(const std::vector<char>& marked, const Raster& r
   return d;
 }
 
+// out.slack and out.target (notation in shell_region.hpp). s(d): the largest k-Lipschitz
+// function under a(d) (a(d) at its lowest round the nozzle, a shaped head not being round;
+// +inf past the head's reach), as a table by distance in cells, then + m. Lipschitz, so that
+// shell points printed in order of their times never leave a higher point beside a later,
+// lower one by more than k·d (min(k·d, a(d)) was not: next to the wall it rose as fast as the
+// cone, and the gate found the rib's shell 0.12 mm over a later piece 0.27 mm away).
+void set_slack(ShellRegion& out, const std::vector<double>& dist,
+               const std::vector<char>& patch_node, const std::vector<char>& grown,
+               const FacetedTop& top, double below, const LayerParams& p) {
+  double farthest = 0;
+  for (double d : dist)
+    if (std::isfinite(d)) farthest = std::max(farthest, d);
+  const HeadClearance head(p.toolhead);
+  const std::size_t n = static_cast<std::size_t>(farthest / top.cell) + 2;
+  std::vector<double> lip(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const double d = static_cast<double>(i) * top.cell;
+    double a = kInf;
+    if (d <= head.reach())
+      for (int k = 0; k < 16; ++k)
+        a = std::min(a, head.allowance(d * Vec2(std::cos(k * M_PI / 8), std::sin(k * M_PI / 8))));
+    lip[i] = a;
+  }
+  const double step = kSlope * top.cell;
+  lip[0] = std::min(lip[0], 0.0);
+  for (std::size_t i = 1; i < n; ++i) lip[i] = std::min(lip[i], lip[i - 1] + step);
+  for (std::size_t i = n - 1; i-- > 0;) lip[i] = std::min(lip[i], lip[i + 1] + step);
+  const double m = 0.25 * p.layer_height;
+  out.slack = top;
+  for (std::size_t q = 0; q < dist.size(); ++q) {
+    if (!std::isfinite(dist[q])) {  // nothing stands above anywhere (not called then)
+      out.slack.h[q] = 1e9;
+      continue;
+    }
+    const double f = dist[q] / top.cell;
+    const std::size_t i = std::min(static_cast<std::size_t>(f), n - 2);
+    out.slack.h[q] = lip[i] + (lip[i + 1] - lip[i]) * (f - static_cast<double>(i)) + m;
+  }
+  // Z: the height the most patch nodes can be printed at, their intervals
+  // [H − min(s, below), H + s] (a sweep over their ends, opens before closes).
+  std::vector<std::pair<double, int>> ends;
+  for (std::size_t q = 0; q < dist.size(); ++q)
+    if (patch_node[q] && !grown[q]) {
+      ends.emplace_back(top.h[q] - std::min(out.slack.h[q], below), -1);
+      ends.emplace_back(top.h[q] + out.slack.h[q], +1);
+    }
+  std::sort(ends.begin(), ends.end());
+  int open = 0, most = -1;
+  for (const auto& [z, kind] : ends) {
+    open -= kind;
+    if (open > most) most = open, out.target = z;
+  }
+}
+
 }  // namespace
 
 ShellRegion shell_region(const TriangleMesh& mesh, const std::vector<char>& in_patch,
@@ -154,52 +208,7 @@ ShellRegion shell_region(const TriangleMesh& mesh, const std::vector<char>& in_p
     out.refused = at("the part stands above most of the curved top", first);
     return out;
   }
-  // s(d): the largest k-Lipschitz function under a(d) (a(d) at its lowest round the nozzle, a
-  // shaped head not being round; +inf past the head's reach), as a table by distance in cells,
-  // then + m. Lipschitz, so that shell points printed in order of U + s never leave a higher
-  // point beside a later, lower one by more than k·d (min(k·d, a(d)) was not: next to the wall
-  // it rose as fast as the cone, and the gate found the rib's shell 0.12 mm over a later piece
-  // 0.27 mm away).
-  const std::vector<double> dist = distance_to(above, r);
-  double farthest = 0;
-  for (double d : dist)
-    if (std::isfinite(d)) farthest = std::max(farthest, d);
-  const HeadClearance head(p.toolhead);
-  const std::size_t n = static_cast<std::size_t>(farthest / top.cell) + 2;
-  std::vector<double> lip(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    const double d = static_cast<double>(i) * top.cell;
-    double a = kInf;
-    if (d <= head.reach())
-      for (int k = 0; k < 16; ++k)
-        a = std::min(a, head.allowance(d * Vec2(std::cos(k * M_PI / 8), std::sin(k * M_PI / 8))));
-    lip[i] = a;
-  }
-  const double step = kSlope * top.cell;
-  lip[0] = std::min(lip[0], 0.0);
-  for (std::size_t i = 1; i < n; ++i) lip[i] = std::min(lip[i], lip[i - 1] + step);
-  for (std::size_t i = n - 1; i-- > 0;) lip[i] = std::min(lip[i], lip[i + 1] + step);
-  const double m = 0.25 * p.layer_height;
-  out.slack = top;
-  for (std::size_t q = 0; q < dist.size(); ++q) {
-    const double f = dist[q] / top.cell;
-    const std::size_t i = std::min(static_cast<std::size_t>(f), n - 2);
-    out.slack.h[q] = lip[i] + (lip[i + 1] - lip[i]) * (f - static_cast<double>(i)) + m;
-  }
-  // Z: the height the most patch nodes can be printed at, their intervals
-  // [H − min(s, below), H + s] (a sweep over their ends, opens before closes).
-  std::vector<std::pair<double, int>> ends;
-  for (std::size_t q = 0; q < dist.size(); ++q)
-    if (patch_node[q] && !grown[q]) {
-      ends.emplace_back(top.h[q] - std::min(out.slack.h[q], below), -1);
-      ends.emplace_back(top.h[q] + out.slack.h[q], +1);
-    }
-  std::sort(ends.begin(), ends.end());
-  int open = 0, most = -1;
-  for (const auto& [z, kind] : ends) {
-    open -= kind;
-    if (open > most) most = open, out.target = z;
-  }
+  set_slack(out, distance_to(above, r), patch_node, grown, top, below, p);
   return out;
 }
 
