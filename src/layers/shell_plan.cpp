@@ -37,11 +37,17 @@ std::vector<double> core_boundaries(double h1, double h_c, double h_min, double 
   return z;
 }
 
-// An overhang or another printable up-facing surface (not of the patches) within `overhang`
+// Overhangs and other printable up-facing surfaces (not of the patches) within `overhang`
 // (overhangs) or half a millimetre (tops) under the shell's bottom, inside R: why the shell
-// cannot rest on the core there, naming the place; empty when none.
-std::string under_shell(const TriangleMesh& mesh, const std::vector<char>& in_patch,
-                        const ShellPlan& s, double max_angle_deg, double overhang) {
+// cannot rest on the core there, naming the first place (empty when none), and every such face.
+struct Under {
+  std::string why;
+  std::vector<char> faces;
+};
+Under under_shell(const TriangleMesh& mesh, const std::vector<char>& in_patch, const ShellPlan& s,
+                  double max_angle_deg, double overhang) {
+  Under u;
+  u.faces.assign(mesh.faces.size(), 0);
   const double cos_max = std::cos(max_angle_deg * kDeg);
   for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
     if (in_patch[f]) continue;
@@ -58,12 +64,16 @@ std::string under_shell(const TriangleMesh& mesh, const std::vector<char>& in_pa
     const double margin = is_overhang ? overhang : 0.5;
     const Vec3 c = (v[0] + v[1] + v[2]) / 3.0;
     for (const Vec3& q : {v[0], v[1], v[2], c})
-      if (s.in_region(q.x(), q.y()) && q.z() > s.bottom(q.x(), q.y()) - margin)
-        return at(is_overhang ? "an overhang lies under the shell"
-                              : "another printable surface lies under the shell",
-                  q);
+      if (s.in_region(q.x(), q.y()) && q.z() > s.bottom(q.x(), q.y()) - margin) {
+        if (u.why.empty())
+          u.why = at(is_overhang ? "an overhang lies under the shell"
+                                 : "another printable surface lies under the shell",
+                     q);
+        u.faces[f] = 1;
+        break;
+      }
   }
-  return {};
+  return u;
 }
 
 }  // namespace
@@ -134,7 +144,7 @@ ShellPlan plan_shell(const TriangleMesh& mesh, const Analysis& a, const std::vec
   const int N0 = s.N;
   const double thin = 1.5 * h_c - s.reach + 0.05;
   s.below = s.t - s.reach - 0.01;
-  ShellRegion region = shell_region(mesh, in_patch, s.top, s.below, p);
+  ShellRegion region = shell_region(mesh, in_patch, {}, s.top, s.below, p);
   if (!region.refused.empty()) {
     s.refused = region.refused;
     return s;
@@ -142,16 +152,31 @@ ShellPlan plan_shell(const TriangleMesh& mesh, const Analysis& a, const std::vec
   s.region = std::move(region.mask);
   s.slack = std::move(region.slack);
   s.target = region.target;
-  std::string first_refusal;
+  Under first;
   for (int N = N0; N >= 1; --N) {
     s.N = N;
-    const std::string why = under_shell(mesh, in_patch, s, p.max_angle_deg, N == N0 ? 0.5 : thin);
-    if (why.empty()) break;
-    if (first_refusal.empty()) first_refusal = why;
-    if (N == 1) {
-      s.refused = first_refusal;
-      return s;
+    Under u = under_shell(mesh, in_patch, s, p.max_angle_deg, N == N0 ? 0.5 : thin);
+    if (u.why.empty()) break;
+    if (N == N0) first = std::move(u);
+    if (N > 1) continue;
+    // Not even one layer rests on the core there: the shell leaves those surfaces' footprints
+    // out, and the core prints them planar (as it prints what stands above the top).
+    s.N = N0;
+    region = shell_region(mesh, in_patch, first.faces, s.top, s.below, p);
+    if (region.refused.empty()) {
+      s.region = std::move(region.mask);
+      s.slack = std::move(region.slack);
+      s.target = region.target;
+      if (under_shell(mesh, in_patch, s, p.max_angle_deg, 0.5).why.empty()) {
+        char buf[300];
+        std::snprintf(buf, sizeof buf, "%.0f mm² of it printed planar: %s", region.left_out,
+                      first.why.c_str());
+        s.left_out = buf;
+        break;
+      }
     }
+    s.refused = first.why;
+    return s;
   }
 
   // The core: up to the highest B + a, landing on the flat patches' heights.

@@ -50,7 +50,10 @@ struct ShellPlan {
     return std::clamp(target, u - std::min(s, below), u + s);
   }
   double target = std::numeric_limits<double>::infinity();  ///< Z (shell_region.hpp), mm
-  double below = 0;                                         ///< s⁻'s bound, t − a − 0.01, mm
+  /// What of the patches the shell leaves to the core because an overhang or another surface
+  /// lies under it there, and why (empty: none).
+  std::string left_out;
+  double below = 0;  ///< s⁻'s bound, t − a − 0.01, mm
 
   double bottom(double x, double y) const { return top.height(x, y) - N * t; }
   /// The core's layer with top z is printed where H >= this level (z <= B + a), mm.

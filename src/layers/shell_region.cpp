@@ -14,6 +14,7 @@ constexpr double kAbove = 0.02;  ///< mm: the part stands above H by more than t
 /// bead) to 0.13 mm, under the check's 0.05 + h/2.
 constexpr double kSlope = 0.15;
 constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kMostBanded = 0.5;  ///< share of the patch a shell may print in bands
 
 std::string at(const char* what, const Vec3& p) {
   char buf[240];
@@ -60,9 +61,10 @@ struct Raster {
 
 // The nodes where the part stands above H: nodes inside a triangle (from above) whose plane is
 // higher there, and the nearest node to any point of a triangle's edges (every half cell) that
-// is, which catches walls and slivers that cover no node. `first` gets such a point.
+// is, which catches walls and slivers that cover no node. `first` gets such a point. Faces
+// marked in `kept_out` (may be empty) mark every node they cover or pass near, at any height.
 std::vector<char> stands_above(const TriangleMesh& mesh, const std::vector<char>& in_patch,
-                               const Raster& r, Vec3* first) {
+                               const std::vector<char>& kept_out, const Raster& r, Vec3* first) {
   const FacetedTop& H = r.t;
   std::vector<char> above(static_cast<std::size_t>(H.nx) * H.ny, 0);
   bool found = false;
@@ -74,16 +76,17 @@ std::vector<char> stands_above(const TriangleMesh& mesh, const std::vector<char>
     if (in_patch[f]) continue;
     const auto& F = mesh.faces[f];
     const Vec3 v[3] = {mesh.vertices[F[0]], mesh.vertices[F[1]], mesh.vertices[F[2]]};
+    const double rise = !kept_out.empty() && kept_out[f] ? -kInf : kAbove;
     r.covered(v[0], v[1], v[2], [&](int i, int j, double z) {
       const std::size_t q = r.index(i, j);
-      if (z > H.h[q] + kAbove) mark(q, Vec3(r.node(i, j).x(), r.node(i, j).y(), z));
+      if (z > H.h[q] + rise) mark(q, Vec3(r.node(i, j).x(), r.node(i, j).y(), z));
     });
     for (int k = 0; k < 3; ++k) {
       const Vec3 &A = v[k], &B = v[(k + 1) % 3];
       const int n = 1 + static_cast<int>((B - A).head<2>().norm() / (0.5 * H.cell));
       for (int s = 0; s <= n; ++s) {
         const Vec3 q = A + (B - A) * (static_cast<double>(s) / n);
-        if (q.z() > H.height(q.x(), q.y()) + kAbove) mark(r.nearest(q.x(), q.y()), q);
+        if (q.z() > H.height(q.x(), q.y()) + rise) mark(r.nearest(q.x(), q.y()), q);
       }
     }
   }
@@ -169,16 +172,18 @@ void set_slack(ShellRegion& out, const std::vector<double>& dist,
     open -= kind;
     if (open > most) most = open, out.target = z;
   }
+  out.banded = ends.empty() ? 0 : 1.0 - 2.0 * most / static_cast<double>(ends.size());
 }
 
 }  // namespace
 
 ShellRegion shell_region(const TriangleMesh& mesh, const std::vector<char>& in_patch,
-                         const FacetedTop& top, double below, const LayerParams& p) {
+                         const std::vector<char>& kept_out, const FacetedTop& top, double below,
+                         const LayerParams& p) {
   ShellRegion out;
   const Raster r{top};
   Vec3 first{0, 0, 0};
-  std::vector<char> above = stands_above(mesh, in_patch, r, &first);
+  std::vector<char> above = stands_above(mesh, in_patch, kept_out, r, &first);
   if (std::find(above.begin(), above.end(), 1) == above.end()) return out;  // R: everywhere
   // R shrinks by a node at its edge: the edges' points were marked at their nearest node only.
   std::vector<char> grown = above;
@@ -204,11 +209,24 @@ ShellRegion shell_region(const TriangleMesh& mesh, const std::vector<char>& in_p
   std::size_t on_patch = 0, in_r = 0;
   for (std::size_t q = 0; q < above.size(); ++q)
     if (patch_node[q]) ++on_patch, in_r += !grown[q];
+  out.left_out = static_cast<double>(on_patch - in_r) * top.cell * top.cell;
   if (on_patch == 0 || 2 * in_r < on_patch) {
     out.refused = at("the part stands above most of the curved top", first);
     return out;
   }
   set_slack(out, distance_to(above, r), patch_node, grown, top, below, p);
+  // Each band is printed apart, with its own travels and a seam: on the ankle base, banded
+  // over 92 % of its heel, the shell took 402 printed layers and 1h33m against the planar
+  // print's 85 and 32m. Past half the patch, planar serves the user better (the rib against a
+  // tower, 46 %: 47m against 27m, its top within 0.03 mm on 96 % against 31 %).
+  if (out.banded > kMostBanded) {
+    char buf[300];
+    std::snprintf(buf, sizeof buf,
+                  "the part stands above the curved top round %.0f %% of it, where the shell "
+                  "would follow it up in bands, each printed apart (near (%.2f, %.2f))",
+                  100 * out.banded, first.x(), first.y());
+    out.refused = buf;
+  }
   return out;
 }
 

@@ -37,6 +37,11 @@ struct ShellRegion {
   /// s(p) on H's raster, mm; empty with an empty mask.
   FacetedTop slack;
   /// Z, mm: the height most of the patch can be printed at (+inf with an empty mask).
+  /// The share of the patch's nodes that cannot take Z, printed in bands beside what stands
+  /// above (more than half: refused).
+  double banded = 0;
+  /// The patches' area outside R, mm² (printed planar by the core).
+  double left_out = 0;
   double target = std::numeric_limits<double>::infinity();
   /// Why no shell can print here (empty: it can): the patch lies mostly under other material;
   /// names a place.
@@ -44,10 +49,12 @@ struct ShellRegion {
 };
 
 /// Inputs: the placed mesh, whether each face is one of the shell's patches (size = faces),
-/// H, how far a point may be printed before its height (`below`, mm: the shell's lowest layer
-/// must come after the core under it) and the printer's layer height and head. Output: R, the
-/// slack and Z, or `refused`.
+/// faces whose whole footprint is to be left out of R (an overhang under the shell; empty or
+/// size = faces), H, how far a point may be printed before its height (`below`, mm: the shell's
+/// lowest layer must come after the core under it) and the printer's layer height and head. Output:
+/// R, the slack and Z, or `refused`.
 ShellRegion shell_region(const TriangleMesh& mesh, const std::vector<char>& in_patch,
-                         const FacetedTop& top, double below, const LayerParams& p);
+                         const std::vector<char>& kept_out, const FacetedTop& top, double below,
+                         const LayerParams& p);
 
 }  // namespace nonplanar::layers

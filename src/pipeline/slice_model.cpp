@@ -181,7 +181,8 @@ Expected<std::optional<SliceResult>> try_shell(const TriangleMesh& mesh, const S
     r.notices.push_back(std::move(kept));
   }
   r.notices.push_back({Notice::Kind::shell, -1,
-                       name + ": curved shell over a planar core (no stack over a plane fits it)"});
+                       name + ": curved shell over a planar core (no stack over a plane fits it)" +
+                           (plan.left_out.empty() ? "" : "; " + plan.left_out)});
   if (!r.gcode.empty()) r.gcode = engine_header(route, r.header, plan.core.at(1)) + r.gcode;
   r.nonplanar = true;
   r.shell_layers = plan.N;

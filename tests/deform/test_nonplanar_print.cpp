@@ -197,6 +197,28 @@ TEST(NonplanarPrint, RibBesideATallerTowerPrintsAsAShellBetweenTheTowersLayers) 
   }
 }
 
+// The rib over a void whose ceiling lies 0.25 mm under its top at x = 20: no layer of a
+// shell rests on the core there. The shell leaves the void's footprint to the planar core and
+// prints the rest (it was refused whole: within 0.03 mm on 31 % of the top).
+TEST(NonplanarPrint, RibOverAVoidLeavesItsFootprintPlanar) {
+  TriangleMesh m = test::rib();
+  TriangleMesh hole = test::box({20, 3, 5}, {40, 9, 7.1});
+  for (auto& f : hole.faces) std::swap(f[1], f[2]);
+  test::append(m, hole);
+  const Outcome o = run(m);
+  const LayerParams lp = make_job(PrintConfig{}).layers;
+  EXPECT_TRUE(o.result.nonplanar);
+  EXPECT_EQ(o.result.shell_layers, 4);
+  EXPECT_EQ(o.figures.collisions, 0u);
+  EXPECT_GE(o.figures.thickness_min, lp.min_layer_height - 1e-3);
+  EXPECT_LE(o.figures.thickness_max, lp.max_layer_height + 1e-3);
+  EXPECT_GT(o.figures.within_share, 0.8);  // the planar footprint: about 12 % of the top
+  bool said = false;
+  for (const Notice& n : o.result.notices)
+    said |= n.text.find("printed planar: an overhang") != std::string::npos;
+  EXPECT_TRUE(said);
+}
+
 // A hollow part (#19: "part is not solid ... up to the patch" on mouse shells and hulls): no
 // stack fits, and a shell rests on the wall under the top. With 1.5 mm walls the usual four
 // layers fit over it; with 0.8 mm walls the ceiling lay within 0.5 mm under their bottom and

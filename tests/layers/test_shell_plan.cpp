@@ -3,6 +3,8 @@
 // them, and the parts it must refuse.
 #include <gtest/gtest.h>
 
+#include "nonplanar/io.hpp"
+
 #include <cmath>
 
 #include "layers/shell_plan.hpp"
@@ -91,12 +93,21 @@ TEST(ShellPlan, RefusesWhatTheShellCannotCover) {
   const std::string stands = plan(covered).refused;
   EXPECT_NE(stands.find("the part stands above most of the curved top"), std::string::npos)
       << stands;
-  // A void whose ceiling is 0.25 mm under the top at x = 20 (H = 7.35 mm): no core layer fits
-  // between it and even a one-layer shell.
+}
+
+// A void whose ceiling is 0.25 mm under the top at x = 20 (H = 7.35 mm): no core layer fits
+// between it and even a one-layer shell. The shell leaves the void's footprint to the core,
+// which prints it planar, and says so (it was refused whole).
+TEST(ShellPlan, LeavesOutWhereAnOverhangLiesUnderIt) {
   TriangleMesh hollow = test::rib();
   test::append(hollow, void_box({20, 3, 5}, {40, 9, 7.1}));
-  const std::string why = plan(hollow).refused;
-  EXPECT_NE(why.find("overhang lies under the shell"), std::string::npos) << why;
+  const layers::ShellPlan s = plan(hollow);
+  ASSERT_TRUE(s.refused.empty()) << s.refused;
+  EXPECT_EQ(s.N, 4);
+  EXPECT_NE(s.left_out.find("an overhang lies under the shell"), std::string::npos) << s.left_out;
+  EXPECT_FALSE(s.in_region(30, 6));
+  EXPECT_TRUE(s.in_region(70, 6));
+  EXPECT_TRUE(s.in_region(10, 6));
 }
 
 // A tower against the rib's side (x 30-40), where the rib's top runs from 10.0 to 11.7 mm
@@ -132,6 +143,19 @@ TEST(ShellPlan, TakesFewerLayersOverAThinWall) {
   EXPECT_EQ(s.N, 3);
   EXPECT_EQ(plan(test::rib()).N, 4);
   EXPECT_GE(s.bottom(20, 6) - 6.25, 0.23 - 1e-6);
+}
+
+// The CurviSlicer ankle base: its heel's curved top is ringed by a rim standing above it, so a
+// shell beside the rim would follow it up in bands over 92 % of the top (printed as 402 layers
+// and 1h33m against the planar 85 and 32m): refused, and the part prints planar.
+TEST(ShellPlan, RefusesAShellMostlyPrintedInBands) {
+  const auto dir = test::shared_models();
+  if (dir.empty()) GTEST_SKIP() << "../shared/models not present";
+  auto m = load_mesh(dir / "np_curvislicer_anklebase_small.stl", {}, {});
+  ASSERT_TRUE(m);
+  const Analysis a = *analyze(m->mesh, {}, {});
+  const std::string why = layers::choose_shell(m->mesh, a, LayerParams{}).refused;
+  EXPECT_NE(why.find("in bands"), std::string::npos) << why;
 }
 
 }  // namespace
