@@ -65,7 +65,7 @@ void split_by_slot(const ExtrusionPath& p, const layers::ShellPlan& plan,
   };
   // Segments cut to 0.2 mm first: along a long one U + s need not be monotone, and a point
   // inside it could belong to another slot than both ends.
-  ExtrusionPath fine = p;
+  ExtrusionPath fine;
   fine.points.assign(1, p.points.front()), fine.height.assign(1, p.height.front());
   for (std::size_t i = 1; i < p.points.size(); ++i) {
     const Vec3 &a = p.points[i - 1], &b = p.points[i];
@@ -76,7 +76,9 @@ void split_by_slot(const ExtrusionPath& p, const layers::ShellPlan& plan,
       fine.height.push_back(p.height[i - 1] + (p.height[i] - p.height[i - 1]) * f);
     }
   }
-  ExtrusionPath piece = fine;
+  ExtrusionPath empty = p;  // the path's role, width and speed, without points
+  empty.points.clear(), empty.height.clear();
+  ExtrusionPath piece = empty;
   piece.points.assign(1, fine.points.front()), piece.height.assign(1, fine.height.front());
   int slot = slot_of(fine.points.front());
   for (std::size_t i = 1; i < fine.points.size(); ++i) {
@@ -96,7 +98,7 @@ void split_by_slot(const ExtrusionPath& p, const layers::ShellPlan& plan,
       const double hq = ha + (hb - ha) * hi;
       piece.points.push_back(q), piece.height.push_back(hq);
       if (piece.points.size() >= 2) emit(slot, std::move(piece));
-      piece = fine;
+      piece = empty;
       piece.points.assign(1, q), piece.height.assign(1, hq);
       slot = slot_of(q + (b - q) * 1e-6);
       if (slot == next) break;
@@ -122,8 +124,9 @@ std::vector<LayerToolpaths> interleave(std::vector<LayerToolpaths> core,
       split_by_slot(p, plan, tops, [&](int k, ExtrusionPath&& piece) {
         auto& s = slots[static_cast<std::size_t>(k)];
         if (!in[static_cast<std::size_t>(k)]) {
-          LayerToolpaths part = L;
-          part.paths.clear(), part.max_z = -1e300;
+          LayerToolpaths part;  // L's figures, none of its paths yet
+          part.height = L.height, part.nonplanar = L.nonplanar, part.max_slope = L.max_slope;
+          part.max_z = -1e300;
           s.push_back(std::move(part));
           in[static_cast<std::size_t>(k)] = &s.back();
         }

@@ -1,6 +1,6 @@
 // Toolpaths of a shell plan (layers/shell_plan.hpp): the planar core, each layer cut back to
-// where it lies under the shell's reach, then the shell's curved layers on top of it, then
-// (where the part stands above the shell's top) the rest of the core.
+// where it lies under the shell's reach, then the shell's curved layers on top of it (where the
+// part stands above the shell's top, the shell's pieces go between the core's layers).
 #pragma once
 
 #include <vector>
@@ -12,8 +12,10 @@
 namespace nonplanar {
 
 /// Inputs: the placed mesh, an accepted plan (plan.refused empty) and the print settings.
-/// Output: the core's layers bottom to top (above plan.insert_z only their part in R), then the
-/// shell's lowest to highest, then the core's layers above insert_z outside R, in print order; every point's height is the thickness under it (the shell's lowest layer fills the
+/// Output: the core's layers bottom to top, then the shell's lowest to highest, in print order;
+/// with a region (plan.region), each shell point is printed right after the core's last layer
+/// whose top is at most plan.slot_level there, so the shell's layers come in pieces between the
+/// core's. Every point's height is the thickness under it (the shell's lowest layer fills the
 /// core's stairs). Errors: those of slicing, normalisation and mapping; cancelled.
 Expected<std::vector<LayerToolpaths>> shell_toolpaths(const TriangleMesh& mesh,
                                                       const layers::ShellPlan& plan,

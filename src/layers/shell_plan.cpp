@@ -76,6 +76,36 @@ Under under_shell(const TriangleMesh& mesh, const std::vector<char>& in_patch, c
   return u;
 }
 
+void take_region(ShellPlan& s, ShellRegion&& r) {
+  s.region = std::move(r.mask);
+  s.slack = std::move(r.slack);
+  s.target = r.target;
+}
+
+// The shell on the core: with s.N layers if nothing lies within half a millimetre under it;
+// else with fewer, down to one, where overhangs keep `thin` under its bottom (a core layer fits
+// between a thin wall's ceiling and the stairs); else with s.N layers again, the footprints of
+// what lies under it left to the planar core. Sets s.N (and R, s.left_out); returns why none of
+// these works (empty: one does).
+std::string rest_on_core(const TriangleMesh& mesh, const std::vector<char>& in_patch,
+                         const LayerParams& p, double thin, ShellPlan& s) {
+  const int N0 = s.N;
+  Under first = under_shell(mesh, in_patch, s, p.max_angle_deg, 0.5);
+  if (first.why.empty()) return {};
+  for (s.N = N0 - 1; s.N >= 1; --s.N)
+    if (under_shell(mesh, in_patch, s, p.max_angle_deg, thin).why.empty()) return {};
+  s.N = N0;
+  ShellRegion region = shell_region(mesh, in_patch, first.faces, s.top, s.below, p);
+  if (!region.refused.empty()) return first.why;
+  const double left_out = region.left_out;
+  take_region(s, std::move(region));
+  if (!under_shell(mesh, in_patch, s, p.max_angle_deg, 0.5).why.empty()) return first.why;
+  char buf[300];
+  std::snprintf(buf, sizeof buf, "%.0f mm² of it printed planar: %s", left_out, first.why.c_str());
+  s.left_out = buf;
+  return {};
+}
+
 }  // namespace
 
 double ShellPlan::core_top(double x, double y) const {
@@ -134,48 +164,21 @@ ShellPlan plan_shell(const TriangleMesh& mesh, const Analysis& a, const std::vec
                      1.0;
   s.top = faceted_top(mesh, P, 0.1, pad, std::tan(0.8 * p.max_angle_deg * kDeg) / M_SQRT2);
 
-  // Where the part stands above H, the shell prints only in R (shell_region.hpp). Inside R,
-  // no other printable up-facing surface may lie within half a millimetre under the shell,
-  // nor an overhang (a hollow part's ceiling). Over a wall thinner than that (0.8 mm under a
-  // hollow roof) the shell takes fewer layers, down to one: the core still stands under it
-  // wherever a core layer fits between the ceiling and B + a (overhang margin, `thin`).
+  // Where the part stands above H, the shell prints only in R (shell_region.hpp); inside R it
+  // must rest on the core (rest_on_core: fewer layers over a thin wall, or what lies under it
+  // left to the planar core).
   std::vector<char> in_patch(mesh.faces.size(), 0);
   for (int f : P.faces) in_patch[static_cast<std::size_t>(f)] = 1;
-  const int N0 = s.N;
-  const double thin = 1.5 * h_c - s.reach + 0.05;
   s.below = s.t - s.reach - 0.01;
   ShellRegion region = shell_region(mesh, in_patch, {}, s.top, s.below, p);
   if (!region.refused.empty()) {
     s.refused = region.refused;
     return s;
   }
-  s.region = std::move(region.mask);
-  s.slack = std::move(region.slack);
-  s.target = region.target;
-  Under first;
-  for (int N = N0; N >= 1; --N) {
-    s.N = N;
-    Under u = under_shell(mesh, in_patch, s, p.max_angle_deg, N == N0 ? 0.5 : thin);
-    if (u.why.empty()) break;
-    if (N == N0) first = std::move(u);
-    if (N > 1) continue;
-    // Not even one layer rests on the core there: the shell leaves those surfaces' footprints
-    // out, and the core prints them planar (as it prints what stands above the top).
-    s.N = N0;
-    region = shell_region(mesh, in_patch, first.faces, s.top, s.below, p);
-    if (region.refused.empty()) {
-      s.region = std::move(region.mask);
-      s.slack = std::move(region.slack);
-      s.target = region.target;
-      if (under_shell(mesh, in_patch, s, p.max_angle_deg, 0.5).why.empty()) {
-        char buf[300];
-        std::snprintf(buf, sizeof buf, "%.0f mm² of it printed planar: %s", region.left_out,
-                      first.why.c_str());
-        s.left_out = buf;
-        break;
-      }
-    }
-    s.refused = first.why;
+  take_region(s, std::move(region));
+  if (const std::string why = rest_on_core(mesh, in_patch, p, 1.5 * h_c - s.reach + 0.05, s);
+      !why.empty()) {
+    s.refused = why;
     return s;
   }
 

@@ -37,9 +37,13 @@ struct ShellPlan {
   /// Where the shell prints (shell_region.hpp): empty when the part stands nowhere above H,
   /// else +1 on R's nodes. Outside R the core prints every layer whole.
   FacetedTop region;
-  /// s on H's raster (shell_region.hpp): a point of shell layer j at height u is printed after
-  /// the core's layers up to u + s, before the rest. Empty: after the whole core.
+  /// s on H's raster, mm (shell_region.hpp); empty: the shell after the whole core.
   FacetedTop slack;
+  double target = std::numeric_limits<double>::infinity();  ///< Z (shell_region.hpp), mm
+  double below = 0;  ///< the bound of s⁻, t − a − 0.01, mm
+  /// What of the patches the shell leaves to the core because an overhang or another surface
+  /// lies under it there, and why (empty: none).
+  std::string left_out;
 
   bool in_region(double x, double y) const { return region.empty() || region.height(x, y) >= 0; }
   /// τ (shell_region.hpp): the core's layers up to this height are printed before the shell's
@@ -49,12 +53,6 @@ struct ShellPlan {
     const double s = slack.height(x, y);
     return std::clamp(target, u - std::min(s, below), u + s);
   }
-  double target = std::numeric_limits<double>::infinity();  ///< Z (shell_region.hpp), mm
-  /// What of the patches the shell leaves to the core because an overhang or another surface
-  /// lies under it there, and why (empty: none).
-  std::string left_out;
-  double below = 0;  ///< s⁻'s bound, t − a − 0.01, mm
-
   double bottom(double x, double y) const { return top.height(x, y) - N * t; }
   /// The core's layer with top z is printed where H >= this level (z <= B + a), mm.
   double core_level(double z) const { return z - reach + N * t; }

@@ -10,8 +10,8 @@ namespace {
 
 constexpr double kAbove = 0.02;  ///< mm: the part stands above H by more than this
 /// k: how fast the slack may grow with distance (mm/mm). The raster's bilinear slack can be
-/// √2 k steep and the chamfer distance 8 % long: 0.2 keeps an inversion at 0.45 mm (the next
-/// bead) to 0.13 mm, under the check's 0.05 + h/2.
+/// √2 k steep and the chamfer distance 8 % long: 0.15 keeps an inversion at 0.45 mm (the next
+/// bead) to 0.10 mm, under the check's 0.05 + h/2 (0.2 left 9 collisions on the rib).
 constexpr double kSlope = 0.15;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kMostBanded = 0.5;  ///< share of the patch a shell may print in bands

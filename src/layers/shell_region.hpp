@@ -6,14 +6,16 @@
 // one node at its edge; outside R the core prints every layer whole. d(p) the distance from p
 // to what stands above; a(d) the head's allowance (toolhead.hpp) at distance d from the
 // nozzle; m = h/4; s(p) = L(d(p)) + m the slack, L the largest k-Lipschitz function under a,
-// k = 0.2.
+// k = 0.15.
 //
 // The order: a point p of shell layer j is given a time τ = clamp(Z, U_j(p) − s⁻(p),
 // U_j(p) + s(p)), s⁻ = min(s, t − a − 0.01) (so the core under p, up to U_0 − (t − a), comes
 // first), and printed right after core layer k, the last with z_k <= τ (after the whole core
 // when none is above it). Z is the height the most of the patch can take, so most of the shell
 // goes at one time, as one piece per layer; next to what stands above, the shell follows the
-// wall up in bands of the core's layer height, with a seam between bands. Why it is safe:
+// wall up in bands of the core's layer height, with a seam between bands (a shell banded over
+// more than half its patch is refused: each band is printed apart). Faces given as `kept_out`
+// (an overhang under the shell) are left out of R like what stands above. Why it is safe:
 // material of the core printed before p stands at most τ <= U + s, and after p starts above
 // τ >= U − s, with s <= a(d) + m (the check's collision is a rise of more than h/2 over a(d));
 // and of two shell points, the one printed first is never higher than the other by more than
@@ -37,22 +39,22 @@ struct ShellRegion {
   /// s(p) on H's raster, mm; empty with an empty mask.
   FacetedTop slack;
   /// Z, mm: the height most of the patch can be printed at (+inf with an empty mask).
+  double target = std::numeric_limits<double>::infinity();
   /// The share of the patch's nodes that cannot take Z, printed in bands beside what stands
   /// above (more than half: refused).
   double banded = 0;
   /// The patches' area outside R, mm² (printed planar by the core).
   double left_out = 0;
-  double target = std::numeric_limits<double>::infinity();
-  /// Why no shell can print here (empty: it can): the patch lies mostly under other material;
-  /// names a place.
+  /// Why no shell can print here (empty: it can): the patch lies mostly under other material,
+  /// or would be banded over more than half; names a place.
   std::string refused;
 };
 
 /// Inputs: the placed mesh, whether each face is one of the shell's patches (size = faces),
 /// faces whose whole footprint is to be left out of R (an overhang under the shell; empty or
 /// size = faces), H, how far a point may be printed before its height (`below`, mm: the shell's
-/// lowest layer must come after the core under it) and the printer's layer height and head. Output:
-/// R, the slack and Z, or `refused`.
+/// lowest layer must come after the core under it) and the printer's layer height and head.
+/// Output: R, the slack and Z, or `refused`.
 ShellRegion shell_region(const TriangleMesh& mesh, const std::vector<char>& in_patch,
                          const std::vector<char>& kept_out, const FacetedTop& top, double below,
                          const LayerParams& p);
