@@ -95,7 +95,8 @@ std::string rest_on_core(const TriangleMesh& mesh, const std::vector<char>& in_p
   for (s.N = N0 - 1; s.N >= 1; --s.N)
     if (under_shell(mesh, in_patch, s, p.max_angle_deg, thin).why.empty()) return {};
   s.N = N0;
-  ShellRegion region = shell_region(mesh, in_patch, first.faces, s.top, s.below, p);
+  ShellRegion region =
+      shell_region(mesh, in_patch, first.faces, s.N * s.t + 0.5, s.top, s.below, p);
   if (!region.refused.empty()) return first.why;
   const double left_out = region.left_out;
   take_region(s, std::move(region));
@@ -170,7 +171,7 @@ ShellPlan plan_shell(const TriangleMesh& mesh, const Analysis& a, const std::vec
   std::vector<char> in_patch(mesh.faces.size(), 0);
   for (int f : P.faces) in_patch[static_cast<std::size_t>(f)] = 1;
   s.below = s.t - s.reach - 0.01;
-  ShellRegion region = shell_region(mesh, in_patch, {}, s.top, s.below, p);
+  ShellRegion region = shell_region(mesh, in_patch, {}, 0, s.top, s.below, p);
   if (!region.refused.empty()) {
     s.refused = region.refused;
     return s;

@@ -62,9 +62,10 @@ struct Raster {
 // The nodes where the part stands above H: nodes inside a triangle (from above) whose plane is
 // higher there, and the nearest node to any point of a triangle's edges (every half cell) that
 // is, which catches walls and slivers that cover no node. `first` gets such a point. Faces
-// marked in `kept_out` (may be empty) mark every node they cover or pass near, at any height.
+// marked in `kept_out` (may be empty) mark the nodes where they reach higher than H − kept_depth.
 std::vector<char> stands_above(const TriangleMesh& mesh, const std::vector<char>& in_patch,
-                               const std::vector<char>& kept_out, const Raster& r, Vec3* first) {
+                               const std::vector<char>& kept_out, double kept_depth,
+                               const Raster& r, Vec3* first) {
   const FacetedTop& H = r.t;
   std::vector<char> above(static_cast<std::size_t>(H.nx) * H.ny, 0);
   bool found = false;
@@ -76,7 +77,7 @@ std::vector<char> stands_above(const TriangleMesh& mesh, const std::vector<char>
     if (in_patch[f]) continue;
     const auto& F = mesh.faces[f];
     const Vec3 v[3] = {mesh.vertices[F[0]], mesh.vertices[F[1]], mesh.vertices[F[2]]};
-    const double rise = !kept_out.empty() && kept_out[f] ? -kInf : kAbove;
+    const double rise = !kept_out.empty() && kept_out[f] ? -kept_depth : kAbove;
     r.covered(v[0], v[1], v[2], [&](int i, int j, double z) {
       const std::size_t q = r.index(i, j);
       if (z > H.h[q] + rise) mark(q, Vec3(r.node(i, j).x(), r.node(i, j).y(), z));
@@ -178,12 +179,12 @@ void set_slack(ShellRegion& out, const std::vector<double>& dist,
 }  // namespace
 
 ShellRegion shell_region(const TriangleMesh& mesh, const std::vector<char>& in_patch,
-                         const std::vector<char>& kept_out, const FacetedTop& top, double below,
-                         const LayerParams& p) {
+                         const std::vector<char>& kept_out, double kept_depth,
+                         const FacetedTop& top, double below, const LayerParams& p) {
   ShellRegion out;
   const Raster r{top};
   Vec3 first{0, 0, 0};
-  std::vector<char> above = stands_above(mesh, in_patch, kept_out, r, &first);
+  std::vector<char> above = stands_above(mesh, in_patch, kept_out, kept_depth, r, &first);
   if (std::find(above.begin(), above.end(), 1) == above.end()) return out;  // R: everywhere
   // R shrinks by a node at its edge: the edges' points were marked at their nearest node only.
   std::vector<char> grown = above;

@@ -14,8 +14,9 @@
 // when none is above it). Z is the height the most of the patch can take, so most of the shell
 // goes at one time, as one piece per layer; next to what stands above, the shell follows the
 // wall up in bands of the core's layer height, with a seam between bands (a shell banded over
-// more than half its patch is refused: each band is printed apart). Faces given as `kept_out`
-// (an overhang under the shell) are left out of R like what stands above. Why it is safe:
+// more than half its patch is refused: each band is printed apart). Where faces given as
+// `kept_out` (an overhang under the shell) come within kept_depth under H, the nodes are left
+// out of R like what stands above. Why it is safe:
 // material of the core printed before p stands at most τ <= U + s, and after p starts above
 // τ >= U − s, with s <= a(d) + m (the check's collision is a rise of more than h/2 over a(d));
 // and of two shell points, the one printed first is never higher than the other by more than
@@ -51,12 +52,12 @@ struct ShellRegion {
 };
 
 /// Inputs: the placed mesh, whether each face is one of the shell's patches (size = faces),
-/// faces whose whole footprint is to be left out of R (an overhang under the shell; empty or
-/// size = faces), H, how far a point may be printed before its height (`below`, mm: the shell's
-/// lowest layer must come after the core under it) and the printer's layer height and head.
-/// Output: R, the slack and Z, or `refused`.
+/// faces to be left out of R where they reach higher than H − kept_depth (mm: an overhang too
+/// close under the shell's bottom; empty or size = faces), H, how far a point may be printed before
+/// its height (`below`, mm: the shell's lowest layer must come after the core under it) and the
+/// printer's layer height and head. Output: R, the slack and Z, or `refused`.
 ShellRegion shell_region(const TriangleMesh& mesh, const std::vector<char>& in_patch,
-                         const std::vector<char>& kept_out, const FacetedTop& top, double below,
-                         const LayerParams& p);
+                         const std::vector<char>& kept_out, double kept_depth,
+                         const FacetedTop& top, double below, const LayerParams& p);
 
 }  // namespace nonplanar::layers
