@@ -63,9 +63,10 @@ struct Raster {
 // higher there, and the nearest node to any point of a triangle's edges (every half cell) that
 // is, which catches walls and slivers that cover no node. `first` gets such a point. Faces
 // marked in `kept_out` (may be empty) mark the nodes where they reach higher than H − kept_depth.
+// So do both ends of a raster step where H is steeper than max_slope (dz/dx).
 std::vector<char> stands_above(const TriangleMesh& mesh, const std::vector<char>& in_patch,
                                const std::vector<char>& kept_out, double kept_depth,
-                               const Raster& r, Vec3* first) {
+                               double max_slope, const Raster& r, Vec3* first) {
   const FacetedTop& H = r.t;
   std::vector<char> above(static_cast<std::size_t>(H.nx) * H.ny, 0);
   bool found = false;
@@ -91,6 +92,20 @@ std::vector<char> stands_above(const TriangleMesh& mesh, const std::vector<char>
       }
     }
   }
+  // Where H itself is steeper than the nozzle may follow (overlapping shells in a mesh put
+  // patch triangles of different heights over one spot: the CurviSlicer car's H rose 0.8 mm in
+  // 0.4 mm), the core prints the part whole, as where it stands above.
+  for (int i = 0; i < H.nx; ++i)
+    for (int j = 0; j < H.ny; ++j)
+      for (const auto& [di, dj] :
+           {std::pair{1, 0}, std::pair{0, 1}, std::pair{1, 1}, std::pair{1, -1}}) {
+        const int i2 = i + di, j2 = j + dj;
+        if (i2 >= H.nx || j2 < 0 || j2 >= H.ny) continue;
+        const std::size_t a = r.index(i, j), b = r.index(i2, j2);
+        if (std::abs(H.h[a] - H.h[b]) <= max_slope * H.cell * std::hypot(di, dj)) continue;
+        mark(a, Vec3(r.node(i, j).x(), r.node(i, j).y(), H.h[a]));
+        mark(b, Vec3(r.node(i2, j2).x(), r.node(i2, j2).y(), H.h[b]));
+      }
   return above;
 }
 
@@ -184,7 +199,8 @@ ShellRegion shell_region(const TriangleMesh& mesh, const std::vector<char>& in_p
   ShellRegion out;
   const Raster r{top};
   Vec3 first{0, 0, 0};
-  std::vector<char> above = stands_above(mesh, in_patch, kept_out, kept_depth, r, &first);
+  std::vector<char> above = stands_above(mesh, in_patch, kept_out, kept_depth,
+                                         std::tan((p.max_angle_deg - 0.5) * M_PI / 180), r, &first);
   if (std::find(above.begin(), above.end(), 1) == above.end()) return out;  // R: everywhere
   // R shrinks by a node at its edge: the edges' points were marked at their nearest node only.
   std::vector<char> grown = above;

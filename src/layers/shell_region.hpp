@@ -2,11 +2,11 @@
 // taller cabin, a curved floor inside a raised rim), and when each piece of it is printed.
 //
 // Notation as in shell_plan.hpp: H the shell's top on its raster; U_j its layer j's top; z_k the
-// core's boundaries. R = {nodes with nothing of the part more than 0.02 mm above H}, shrunk by
-// one node at its edge; outside R the core prints every layer whole. d(p) the distance from p
-// to what stands above; a(d) the head's allowance (toolhead.hpp) at distance d from the
-// nozzle; m = h/4; s(p) = L(d(p)) + m the slack, L the largest k-Lipschitz function under a,
-// k = 0.15.
+// core's boundaries. R = {nodes with nothing of the part more than 0.02 mm above H, where H is
+// no steeper than max_angle}, shrunk by one node at its edge; outside R the core prints every layer
+// whole. d(p) the distance from p to what stands above; a(d) the head's allowance (toolhead.hpp) at
+// distance d from the nozzle; m = h/4; s(p) = L(d(p)) + m the slack, L the largest k-Lipschitz
+// function under a, k = 0.15.
 //
 // The order: a point p of shell layer j is given a time τ = clamp(Z, U_j(p) − s⁻(p),
 // U_j(p) + s(p)), s⁻ = min(s, t − a − 0.01) (so the core under p, up to U_0 − (t − a), comes

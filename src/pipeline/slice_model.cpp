@@ -134,11 +134,9 @@ Expected<SliceResult> attempt(const TriangleMesh& mesh, const SliceJob& job, con
 // gate passes them. Empty when the part is not of that kind or the shell breaks a limit (a
 // notice then says why).
 Expected<std::optional<SliceResult>> try_shell(const TriangleMesh& mesh, const SliceJob& job,
-                                               const Analysis& analysis, SliceResult& planar,
+                                               const layers::ShellPlan& plan,
+                                               const std::string& why_shell, SliceResult& planar,
                                                const Context& ctx) {
-  // All the patches that need curved layers, taken as one top (the CurviSlicer airfoil's top
-  // is two, split at a crease); failing that, the largest alone.
-  const layers::ShellPlan plan = layers::choose_shell(mesh, analysis, job.layers);
   if (plan.patches.empty()) return std::optional<SliceResult>{};
   std::string name = "patch";
   if (plan.patches.size() > 1) name += "es";
@@ -161,7 +159,9 @@ Expected<std::optional<SliceResult>> try_shell(const TriangleMesh& mesh, const S
   if (!printed) return printed.error();
   r.layers = std::move(printed->layers);
   r.gcode = std::move(printed->gcode);
-  r.header = planar.header;
+  // The attempt's header, without its stacks' lines (the shell replaces them).
+  for (const std::string& line : planar.header)
+    if (line.rfind("patch ", 0) != 0) r.header.push_back(line);
   char buf[200];
   std::snprintf(buf, sizeof buf,
                 "%s: a shell of %d curved layers of %.2f mm over %zu planar core layers",
@@ -181,7 +181,7 @@ Expected<std::optional<SliceResult>> try_shell(const TriangleMesh& mesh, const S
     r.notices.push_back(std::move(kept));
   }
   r.notices.push_back({Notice::Kind::shell, -1,
-                       name + ": curved shell over a planar core (no stack over a plane fits it)" +
+                       name + ": curved shell over a planar core (" + why_shell + ")" +
                            (plan.left_out.empty() ? "" : "; " + plan.left_out)});
   if (!r.gcode.empty()) r.gcode = engine_header(route, r.header, plan.core.at(1)) + r.gcode;
   r.nonplanar = true;
@@ -203,6 +203,42 @@ Expected<std::optional<SliceResult>> try_shell(const TriangleMesh& mesh, const S
     return std::optional<SliceResult>{};
   }
   return std::optional<SliceResult>(std::move(r));
+}
+
+// The curved area the patches cover, mm².
+double area_of(const Analysis& a, const std::vector<int>& patches) {
+  double sum = 0;
+  for (int i : patches) sum += a.patches[static_cast<std::size_t>(i)].area;
+  return sum;
+}
+
+// A part whose stacks follow only a little of its curved top (the CurviSlicer car: 172 mm² of
+// roof, while its 486 mm² body, hollow under the hood, has none): a shell over its largest
+// curved patch instead, if that plans and passes the gate. Stacks follow the top more closely
+// and cost no bands, so the patch must be more than twice their area. Only the largest alone:
+// planning costs about a second on a large part (0.6 s more on the bunny), and more patches
+// together were refused on every part tried (the Voron ornament, the bunny, the spiky block).
+Expected<std::optional<SliceResult>> shell_over_stacks(const TriangleMesh& mesh,
+                                                       const SliceJob& job, const Analysis& a,
+                                                       SliceResult& stacked, const Context& ctx) {
+  if (stacked.plan.stacks.empty()) return std::optional<SliceResult>{};
+  std::vector<int> ids;
+  for (const LayerStack& st : stacked.plan.stacks) ids.push_back(st.patch);
+  const double covered = area_of(a, ids);
+  int largest = -1;  // the patches are sorted by decreasing area
+  for (std::size_t i = 0; i < a.patches.size() && largest < 0; ++i)
+    if (a.patches[i].needs_nonplanar()) largest = static_cast<int>(i);
+  if (largest < 0 || area_of(a, {largest}) <= 2 * covered) return std::optional<SliceResult>{};
+  ctx.progress("shell", 0);
+  const layers::ShellPlan plan = layers::plan_shell(mesh, a, {largest}, job.layers);
+  if (!plan.refused.empty()) return std::optional<SliceResult>{};
+  char why[160];
+  std::snprintf(why, sizeof why, "its %.0f mm² print curved, where stacks would cover %.0f mm²",
+                area_of(a, plan.patches), covered);
+  std::vector<Notice> kept = stacked.notices;
+  auto shell = try_shell(mesh, job, plan, why, stacked, ctx);
+  if (shell && !*shell) stacked.notices = std::move(kept);  // the stacks print: no word of it
+  return shell;
 }
 
 }  // namespace
@@ -255,19 +291,21 @@ Expected<SliceResult> slice_rounds(const TriangleMesh& mesh, const SliceJob& job
   std::vector<int> excluded;
   std::vector<Notice> dropped;
   std::vector<std::pair<int, std::string>> offenders;
+  // OrcaSlicer prints no shells (its command line cannot take our layer boundaries): with it,
+  // a part without stacks slices planar at once.
+  const bool shells = job.shells && job.engine.engine != Engine::orcaslicer;
   for (int round = 0; round < 8; ++round) {
-    // OrcaSlicer prints no shells (its command line cannot take our layer boundaries): with
-    // it, a part without stacks slices planar at once.
     bool deferred = false;
-    auto r =
-        attempt(mesh, job, pre, excluded, &offenders,
-                job.shells && job.engine.engine != Engine::orcaslicer ? &deferred : nullptr, ctx);
+    auto r = attempt(mesh, job, pre, excluded, &offenders, shells ? &deferred : nullptr, ctx);
     if (!r) return r;
     if (deferred) {
       // No curved stack: a shell, or else the same attempt sliced planar (its stacks cached).
       r->notices.insert(r->notices.begin(), dropped.begin(), dropped.end());
       ctx.progress("shell", 0);
-      auto shell = try_shell(mesh, job, pre.analysis, *r, ctx);
+      // All the patches that need curved layers, taken as one top (the CurviSlicer airfoil's
+      // top is two, split at a crease); failing that, the largest alone.
+      const layers::ShellPlan plan = layers::choose_shell(mesh, pre.analysis, job.layers);
+      auto shell = try_shell(mesh, job, plan, "no stack over a plane fits it", *r, ctx);
       if (!shell) return shell.error();
       if (*shell) return done(std::move(**shell));
       const std::vector<Notice> notices = std::move(r->notices);
@@ -278,6 +316,11 @@ Expected<SliceResult> slice_rounds(const TriangleMesh& mesh, const SliceJob& job
     }
     if (offenders.empty()) {
       r->notices.insert(r->notices.begin(), dropped.begin(), dropped.end());
+      if (shells) {
+        auto shell = shell_over_stacks(mesh, job, pre.analysis, *r, ctx);
+        if (!shell) return shell.error();
+        if (*shell) return done(std::move(**shell));
+      }
       return done(std::move(r));
     }
     // A stack that met every limit on its own grid broke one in the final paths: print
