@@ -76,10 +76,18 @@ Under under_shell(const TriangleMesh& mesh, const std::vector<char>& in_patch, c
   return u;
 }
 
+// R, the slack and g into the plan, and the notice of what the core prints of the patches.
 void take_region(ShellPlan& s, ShellRegion&& r) {
+  s.left_out.clear();
+  if (r.left_out >= 0.5) {
+    char buf[60];
+    std::snprintf(buf, sizeof buf, "%.0f mm² of it printed planar: ", r.left_out);
+    s.left_out = buf;
+    for (std::size_t k = 0; k < r.why_out.size(); ++k) s.left_out += (k ? "; " : "") + r.why_out[k];
+  }
   s.region = std::move(r.mask);
   s.slack = std::move(r.slack);
-  s.target = r.target;
+  s.levels = std::move(r.levels);
 }
 
 // The shell on the core: with s.N layers if nothing lies within half a millimetre under it;
@@ -98,12 +106,9 @@ std::string rest_on_core(const TriangleMesh& mesh, const std::vector<char>& in_p
   ShellRegion region =
       shell_region(mesh, in_patch, first.faces, s.N * s.t + 0.5, s.top, s.below, p);
   if (!region.refused.empty()) return first.why;
-  const double left_out = region.left_out;
+  region.why_out.push_back(first.why);
   take_region(s, std::move(region));
   if (!under_shell(mesh, in_patch, s, p.max_angle_deg, 0.5).why.empty()) return first.why;
-  char buf[300];
-  std::snprintf(buf, sizeof buf, "%.0f mm² of it printed planar: %s", left_out, first.why.c_str());
-  s.left_out = buf;
   return {};
 }
 

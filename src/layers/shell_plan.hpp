@@ -39,8 +39,8 @@ struct ShellPlan {
   FacetedTop region;
   /// s on H's raster, mm (shell_region.hpp); empty: the shell after the whole core.
   FacetedTop slack;
-  double target = std::numeric_limits<double>::infinity();  ///< Z (shell_region.hpp), mm
-  double below = 0;  ///< the bound of s⁻, t − a − 0.01, mm
+  ShellLevels levels;  ///< g (shell_levels.hpp)
+  double below = 0;    ///< the bound of s⁻, t − a − 0.01, mm
   /// What of the patches the shell leaves to the core because an overhang or another surface
   /// lies under it there, and why (empty: none).
   std::string left_out;
@@ -51,7 +51,7 @@ struct ShellPlan {
   double slot_level(double x, double y, double u) const {
     if (slack.empty()) return std::numeric_limits<double>::infinity();
     const double s = slack.height(x, y);
-    return std::clamp(target, u - std::min(s, below), u + s);
+    return std::clamp(levels.at(u), u - std::min(s, below), u + s);
   }
   double bottom(double x, double y) const { return top.height(x, y) - N * t; }
   /// The core's layer with top z is printed where H >= this level (z <= B + a), mm.

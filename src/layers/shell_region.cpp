@@ -12,9 +12,11 @@ constexpr double kAbove = 0.02;  ///< mm: the part stands above H by more than t
 /// k: how fast the slack may grow with distance (mm/mm). The raster's bilinear slack can be
 /// √2 k steep and the chamfer distance 8 % long: 0.15 keeps an inversion at 0.45 mm (the next
 /// bead) to 0.10 mm, under the check's 0.05 + h/2 (0.2 left 9 collisions on the rib).
-constexpr double kSlope = 0.15;
+constexpr double kSlope = 0.12;
 constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kNarrowest = 0.7;   ///< mm: R narrower than this would print no line
 constexpr double kMostBanded = 0.5;  ///< share of the patch a shell may print in bands
+constexpr int kMaxLevels = 8;        ///< heights g may print the shell at (shell_levels.hpp)
 
 std::string at(const char* what, const Vec3& p) {
   char buf[240];
@@ -63,32 +65,37 @@ struct Raster {
 // higher there, and the nearest node to any point of a triangle's edges (every half cell) that
 // is, which catches walls and slivers that cover no node. `first` gets such a point. Faces
 // marked in `kept_out` (may be empty) mark the nodes where they reach higher than H − kept_depth.
-// So do both ends of a raster step where H is steeper than max_slope (dz/dx).
+// So do both ends of a raster step where H is steeper than max_slope (dz/dx), and `steep` gets
+// the first. Each mark says why (kAboveH first, then the first to mark).
+enum Mark : char { kNone, kAboveH, kSteep, kKept, kNarrow };
 std::vector<char> stands_above(const TriangleMesh& mesh, const std::vector<char>& in_patch,
                                const std::vector<char>& kept_out, double kept_depth,
-                               double max_slope, const Raster& r, Vec3* first) {
+                               double max_slope, const Raster& r, Vec3* first, Vec3* steep) {
   const FacetedTop& H = r.t;
   std::vector<char> above(static_cast<std::size_t>(H.nx) * H.ny, 0);
-  bool found = false;
-  auto mark = [&](std::size_t q, const Vec3& p) {
-    above[q] = 1;
+  bool found = false, found_steep = false;
+  auto mark = [&](std::size_t q, const Vec3& p, Mark why) {
+    if (!above[q] || why == kAboveH) above[q] = why;
     if (!found) found = true, *first = p;
   };
   for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
     if (in_patch[f]) continue;
     const auto& F = mesh.faces[f];
     const Vec3 v[3] = {mesh.vertices[F[0]], mesh.vertices[F[1]], mesh.vertices[F[2]]};
-    const double rise = !kept_out.empty() && kept_out[f] ? -kept_depth : kAbove;
+    const bool kept = !kept_out.empty() && kept_out[f];
+    const double rise = kept ? -kept_depth : kAbove;
+    auto why = [&](double z, double h) { return kept && z <= h + kAbove ? kKept : kAboveH; };
     r.covered(v[0], v[1], v[2], [&](int i, int j, double z) {
       const std::size_t q = r.index(i, j);
-      if (z > H.h[q] + rise) mark(q, Vec3(r.node(i, j).x(), r.node(i, j).y(), z));
+      if (z > H.h[q] + rise) mark(q, Vec3(r.node(i, j).x(), r.node(i, j).y(), z), why(z, H.h[q]));
     });
     for (int k = 0; k < 3; ++k) {
       const Vec3 &A = v[k], &B = v[(k + 1) % 3];
       const int n = 1 + static_cast<int>((B - A).head<2>().norm() / (0.5 * H.cell));
       for (int s = 0; s <= n; ++s) {
         const Vec3 q = A + (B - A) * (static_cast<double>(s) / n);
-        if (q.z() > H.height(q.x(), q.y()) + rise) mark(r.nearest(q.x(), q.y()), q);
+        const double h = H.height(q.x(), q.y());
+        if (q.z() > h + rise) mark(r.nearest(q.x(), q.y()), q, why(q.z(), h));
       }
     }
   }
@@ -103,9 +110,12 @@ std::vector<char> stands_above(const TriangleMesh& mesh, const std::vector<char>
         if (i2 >= H.nx || j2 < 0 || j2 >= H.ny) continue;
         const std::size_t a = r.index(i, j), b = r.index(i2, j2);
         if (std::abs(H.h[a] - H.h[b]) <= max_slope * H.cell * std::hypot(di, dj)) continue;
-        mark(a, Vec3(r.node(i, j).x(), r.node(i, j).y(), H.h[a]));
-        mark(b, Vec3(r.node(i2, j2).x(), r.node(i2, j2).y(), H.h[b]));
+        for (const std::size_t q : {a, b})
+          if (!above[q]) above[q] = kSteep;
+        if (!found_steep)
+          found_steep = true, *steep = Vec3(r.node(i, j).x(), r.node(i, j).y(), H.h[a]);
       }
+  if (!found && found_steep) *first = *steep;
   return above;
 }
 
@@ -136,7 +146,7 @@ std::vector<double> distance_to(const std::vector<char>& marked, const Raster& r
   return d;
 }
 
-// out.slack and out.target (notation in shell_region.hpp). s(d): the largest k-Lipschitz
+// out.slack and out.levels (notation in shell_region.hpp). s(d): the largest k-Lipschitz
 // function under a(d) (a(d) at its lowest round the nozzle, a shaped head not being round;
 // +inf past the head's reach), as a table by distance in cells, then + m. Lipschitz, so that
 // shell points printed in order of their times never leave a higher point beside a later,
@@ -174,21 +184,18 @@ void set_slack(ShellRegion& out, const std::vector<double>& dist,
     const std::size_t i = std::min(static_cast<std::size_t>(f), n - 2);
     out.slack.h[q] = lip[i] + (lip[i + 1] - lip[i]) * (f - static_cast<double>(i)) + m;
   }
-  // Z: the height the most patch nodes can be printed at, their intervals
-  // [H − min(s, below), H + s] (a sweep over their ends, opens before closes).
-  std::vector<std::pair<double, int>> ends;
+  // g: the heights most patch nodes can be printed at (shell_levels.hpp), their intervals
+  // [H − min(s, below), H + s].
+  std::vector<double> u, lo, hi;
   for (std::size_t q = 0; q < dist.size(); ++q)
     if (patch_node[q] && !grown[q]) {
-      ends.emplace_back(top.h[q] - std::min(out.slack.h[q], below), -1);
-      ends.emplace_back(top.h[q] + out.slack.h[q], +1);
+      u.push_back(top.h[q]);
+      lo.push_back(top.h[q] - std::min(out.slack.h[q], below));
+      hi.push_back(top.h[q] + out.slack.h[q]);
     }
-  std::sort(ends.begin(), ends.end());
-  int open = 0, most = -1;
-  for (const auto& [z, kind] : ends) {
-    open -= kind;
-    if (open > most) most = open, out.target = z;
-  }
-  out.banded = ends.empty() ? 0 : 1.0 - 2.0 * most / static_cast<double>(ends.size());
+  LevelChoice levels = choose_levels(u, lo, hi, kMaxLevels);
+  out.levels = std::move(levels.levels);
+  out.banded = levels.banded;
 }
 
 }  // namespace
@@ -198,10 +205,12 @@ ShellRegion shell_region(const TriangleMesh& mesh, const std::vector<char>& in_p
                          const FacetedTop& top, double below, const LayerParams& p) {
   ShellRegion out;
   const Raster r{top};
-  Vec3 first{0, 0, 0};
-  std::vector<char> above = stands_above(mesh, in_patch, kept_out, kept_depth,
-                                         std::tan((p.max_angle_deg - 0.5) * M_PI / 180), r, &first);
-  if (std::find(above.begin(), above.end(), 1) == above.end()) return out;  // R: everywhere
+  Vec3 first{0, 0, 0}, steep{0, 0, 0};
+  std::vector<char> above =
+      stands_above(mesh, in_patch, kept_out, kept_depth,
+                   std::tan((p.max_angle_deg - 0.5) * M_PI / 180), r, &first, &steep);
+  if (std::find_if(above.begin(), above.end(), [](char c) { return c != 0; }) == above.end())
+    return out;  // R: everywhere
   // R shrinks by a node at its edge: the edges' points were marked at their nearest node only.
   std::vector<char> grown = above;
   for (int i = 0; i < top.nx; ++i)
@@ -212,6 +221,19 @@ ShellRegion shell_region(const TriangleMesh& mesh, const std::vector<char>& in_p
             const int i2 = i + di, j2 = j + dj;
             if (i2 >= 0 && j2 >= 0 && i2 < top.nx && j2 < top.ny) grown[r.index(i2, j2)] = 1;
           }
+  // R loses what is narrower than kNarrowest (an opening: what stays kNarrowest / 2 from its
+  // edge, grown back by as much): the core is cut away under R, and where R is too small for
+  // the shell to print a line (a lone node among steep ones on the saddle under a 15° cone) that
+  // left a hole 9 mm deep in the top. What it loses counts as standing above.
+  {
+    const double half = 0.5 * kNarrowest;
+    const std::vector<double> to_edge = distance_to(grown, r);
+    std::vector<char> core(grown.size(), 0);
+    for (std::size_t q = 0; q < grown.size(); ++q) core[q] = !grown[q] && to_edge[q] > half;
+    const std::vector<double> to_core = distance_to(core, r);
+    for (std::size_t q = 0; q < grown.size(); ++q)
+      if (!grown[q] && to_core[q] > half + 1e-9) grown[q] = 1, above[q] = kNarrow;
+  }
   out.mask = top;
   for (std::size_t q = 0; q < grown.size(); ++q) out.mask.h[q] = grown[q] ? -1.0 : 1.0;
 
@@ -223,10 +245,20 @@ ShellRegion shell_region(const TriangleMesh& mesh, const std::vector<char>& in_p
       r.covered(mesh.vertices[F[0]], mesh.vertices[F[1]], mesh.vertices[F[2]],
                 [&](int i, int j, double) { patch_node[r.index(i, j)] = 1; });
     }
-  std::size_t on_patch = 0, in_r = 0;
+  std::size_t on_patch = 0, in_r = 0, count[5] = {0, 0, 0, 0, 0};
   for (std::size_t q = 0; q < above.size(); ++q)
-    if (patch_node[q]) ++on_patch, in_r += !grown[q];
+    if (patch_node[q]) ++on_patch, in_r += !grown[q], ++count[static_cast<int>(above[q])];
   out.left_out = static_cast<double>(on_patch - in_r) * top.cell * top.cell;
+  // Why, as the marks on the patch say (an overhang: the caller says where).
+  if (count[kAboveH] > 0) out.why_out.push_back(at("the part stands above it", first));
+  if (count[kSteep] > 0) {
+    char buf[200];
+    std::snprintf(buf, sizeof buf, "steeper than max_angle (%.1f deg) near (%.2f, %.2f)",
+                  p.max_angle_deg, steep.x(), steep.y());
+    out.why_out.push_back(buf);
+  }
+  if (count[kNarrow] > 0 && out.why_out.empty() && count[kKept] == 0)
+    out.why_out.push_back("too narrow for the shell's lines between what the core prints");
   if (on_patch == 0 || 2 * in_r < on_patch) {
     out.refused = at("the part stands above most of the curved top", first);
     return out;

@@ -8,20 +8,22 @@
 // distance d from the nozzle; m = h/4; s(p) = L(d(p)) + m the slack, L the largest k-Lipschitz
 // function under a, k = 0.15.
 //
-// The order: a point p of shell layer j is given a time τ = clamp(Z, U_j(p) − s⁻(p),
+// The order: a point p of shell layer j is given a time τ = clamp(g(U_j(p)), U_j(p) − s⁻(p),
 // U_j(p) + s(p)), s⁻ = min(s, t − a − 0.01) (so the core under p, up to U_0 − (t − a), comes
 // first), and printed right after core layer k, the last with z_k <= τ (after the whole core
-// when none is above it). Z is the height the most of the patch can take, so most of the shell
-// goes at one time, as one piece per layer; next to what stands above, the shell follows the
-// wall up in bands of the core's layer height, with a seam between bands (a shell banded over
-// more than half its patch is refused: each band is printed apart). Where faces given as
+// when none is above it). g is a non-decreasing step function of a few heights
+// (shell_levels.hpp) that the most of the patch can take, so most of the shell goes at a few
+// times, as a few pieces per layer; next to what stands above, the shell follows the wall up in
+// bands of the core's layer height, with a seam between bands (a shell banded over more than
+// half its patch is refused: each band is printed apart). Where faces given as
 // `kept_out` (an overhang under the shell) come within kept_depth under H, the nodes are left
 // out of R like what stands above. Why it is safe:
 // material of the core printed before p stands at most τ <= U + s, and after p starts above
 // τ >= U − s, with s <= a(d) + m (the check's collision is a rise of more than h/2 over a(d));
 // and of two shell points, the one printed first is never higher than the other by more than
-// k·|p − q| (about; see kSlope), under the nozzle's cone, because both clamps are k-Lipschitz:
-// in each case τ(p) < τ(q) bounds U(p) − U(q) by a difference of slacks.
+// k·|p − q| (about; see kSlope), under the nozzle's cone: if it is higher, g(U(p)) >= g(U(q)),
+// so one of them is clamped, and each case of τ(p) < τ(q) bounds U(p) − U(q) by a difference
+// of k-Lipschitz slacks (s or s⁻).
 #pragma once
 
 #include <limits>
@@ -29,6 +31,7 @@
 #include <vector>
 
 #include "layers/faceted_top.hpp"
+#include "layers/shell_levels.hpp"
 #include "nonplanar/layers.hpp"
 
 namespace nonplanar::layers {
@@ -39,13 +42,17 @@ struct ShellRegion {
   FacetedTop mask;
   /// s(p) on H's raster, mm; empty with an empty mask.
   FacetedTop slack;
-  /// Z, mm: the height most of the patch can be printed at (+inf with an empty mask).
-  double target = std::numeric_limits<double>::infinity();
-  /// The share of the patch's nodes that cannot take Z, printed in bands beside what stands
-  /// above (more than half: refused).
+  /// g: the heights most of the patch can be printed at (shell_levels.hpp); empty with an
+  /// empty mask.
+  ShellLevels levels;
+  /// The share of the patch's nodes that can take no height of g, printed in bands beside what
+  /// stands above (more than half: refused).
   double banded = 0;
   /// The patches' area outside R, mm² (printed planar by the core).
   double left_out = 0;
+  /// Why the core prints some of the patches (left_out > 0), each naming a place: the part
+  /// stands above it, or H is steeper there than max_angle.
+  std::vector<std::string> why_out;
   /// Why no shell can print here (empty: it can): the patch lies mostly under other material,
   /// or would be banded over more than half; names a place.
   std::string refused;
@@ -55,7 +62,7 @@ struct ShellRegion {
 /// faces to be left out of R where they reach higher than H − kept_depth (mm: an overhang too
 /// close under the shell's bottom; empty or size = faces), H, how far a point may be printed before
 /// its height (`below`, mm: the shell's lowest layer must come after the core under it) and the
-/// printer's layer height and head. Output: R, the slack and Z, or `refused`.
+/// printer's layer height and head. Output: R, the slack and g, or `refused`.
 ShellRegion shell_region(const TriangleMesh& mesh, const std::vector<char>& in_patch,
                          const std::vector<char>& kept_out, double kept_depth,
                          const FacetedTop& top, double below, const LayerParams& p);

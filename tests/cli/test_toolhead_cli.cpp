@@ -55,23 +55,26 @@ TEST(CliToolhead, ANarrowConeFlattensTheLayersAndTheCheckAgrees) {
   EXPECT_LE(wide_wide["top_surface_deviation"]["p95"].get<double>(), 0.02);
 }
 
-TEST(CliToolhead, ASaddleSteeperThanTheConeFallsBackWithANotice) {
-  // The saddle's top rises at up to 29.5° at its corners; with a 15° cone its patch cannot
-  // keep within the cone and is printed planar, saying so.
+TEST(CliToolhead, ASaddleSteeperThanTheConePrintsItsGentlePartCurved) {
+  // The saddle's top rises at up to 29.5° at its corners. With a 15° cone its patch is what is
+  // under 15°: no stack fits it, and a shell prints it curved while the core prints the rest
+  // (and the odd spot where the facets' top is steeper) planar, saying how much.
   const auto dir = test::temp_dir("cli_toolhead_saddle");
   ASSERT_TRUE(write_stl(dir / "saddle.stl", test::saddle()));
   const std::string mesh = (dir / "saddle.stl").string(), out = (dir / "s.gcode").string();
   const auto s = test::run_cli("slice " + mesh + " -o " + out + " --set nozzle_cone_angle=15");
   ASSERT_EQ(s.code, 0) << s.err;
-  EXPECT_NE(s.err.find("printed planar"), std::string::npos) << s.err;
-  // The run ends on a summary line (#16), after the "wrote" line.
-  const std::string last = "0 of 1 curved patch printed curved, the print is planar (patch 0 ";
-  const std::size_t at = s.err.rfind('\n', s.err.size() - 2);
-  EXPECT_EQ(s.err.substr(at + 1, last.size()), last) << s.err;
-  const auto j = check_json(out, mesh, " --set nozzle_cone_angle=15");
+  EXPECT_NE(s.err.find("curved shell over a planar core"), std::string::npos) << s.err;
+  EXPECT_NE(s.err.find("mm² of it printed planar: "), std::string::npos) << s.err;
+  EXPECT_NE(s.err.find("steeper than max_angle (15.0 deg)"), std::string::npos) << s.err;
+  const auto j = check_json(out, mesh, " --set nozzle_cone_angle=15 --min-angle 2");
   ASSERT_FALSE(j.is_null());
   EXPECT_EQ(j["collisions"], 0);
   EXPECT_LE(j["steepest_extrusion"].get<double>(), 15.5);
+  // Planar: 30 % of the top within 0.03 mm, p95 0.087 mm. A lone node of R among steep ones
+  // once cut the core under it with no shell line to cover it: a hole 9 mm deep.
+  EXPECT_GT(j["top_surface_deviation"]["within_share"].get<double>(), 0.45);
+  EXPECT_LT(j["top_surface_deviation"]["max"].get<double>(), 0.3);
 }
 
 // #16: the MK3S's 0.15 mm SPEED limits (layers 0.15, 0.07-0.25 mm) are too thin for a stack

@@ -1,0 +1,91 @@
+// Notation as in shell_levels.hpp.
+#include "layers/shell_levels.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace nonplanar::layers {
+
+double ShellLevels::at(double u) const {
+  if (z.empty()) return std::numeric_limits<double>::infinity();
+  const double f = std::clamp(std::floor((u - u0) / bin), 0.0, static_cast<double>(last.back()));
+  const auto it = std::lower_bound(last.begin(), last.end(), static_cast<int>(f));
+  return z[static_cast<std::size_t>(it - last.begin())];
+}
+
+LevelChoice choose_levels(const std::vector<double>& u, const std::vector<double>& lo,
+                          const std::vector<double>& hi, int max_levels) {
+  LevelChoice out;
+  const std::size_t n = u.size();
+  if (n == 0 || max_levels < 1) return out;
+  const auto [lo_it, hi_it] = std::minmax_element(u.begin(), u.end());
+  const double u_min = *lo_it, range = *hi_it - u_min;
+  const double bw = std::max(0.02, range / 1000);
+  const int B = static_cast<int>(range / bw) + 1;
+  out.levels.u0 = u_min, out.levels.bin = bw;
+  auto bin_of = [&](double v) {
+    return static_cast<int>(std::clamp(std::floor((v - u_min) / bw), 0.0, B - 1.0));
+  };
+  // Per bin: its nodes' hi, sorted; the highest lo of the nodes in it and every bin below (z of
+  // a range ending there).
+  std::vector<std::vector<double>> his(static_cast<std::size_t>(B));
+  std::vector<double> top_lo(static_cast<std::size_t>(B), -std::numeric_limits<double>::infinity());
+  for (std::size_t k = 0; k < n; ++k) {
+    const auto b = static_cast<std::size_t>(bin_of(u[k]));
+    his[b].push_back(hi[k]);
+    top_lo[b] = std::max(top_lo[b], lo[k]);
+  }
+  for (auto& v : his) std::sort(v.begin(), v.end());
+  for (std::size_t b = 1; b < top_lo.size(); ++b) top_lo[b] = std::max(top_lo[b], top_lo[b - 1]);
+  // below[b][a]: the nodes of bins < a that top_lo[b] lies within (hi >= it), so the range of
+  // bins a … b holds below[b][b + 1] − below[b][a] of them.
+  const auto W = static_cast<std::size_t>(B) + 1;
+  std::vector<int> below(static_cast<std::size_t>(B) * W, 0);
+  for (int b = 0; b < B; ++b) {
+    int* row = &below[static_cast<std::size_t>(b) * W];
+    const double z = top_lo[static_cast<std::size_t>(b)];
+    for (int a = 0; a < B; ++a) {
+      const auto& h = his[static_cast<std::size_t>(a)];
+      row[a + 1] = row[a] + static_cast<int>(h.end() - std::lower_bound(h.begin(), h.end(), z));
+    }
+  }
+  auto count = [&](int a, int b) {
+    const int* row = &below[static_cast<std::size_t>(b) * W];
+    return row[b + 1] - row[a];
+  };
+  // best[L][b + 1]: the most nodes within their level with L ranges over bins 0 … b; from[L][b + 1]
+  // the first bin of the last range.
+  const auto L_max = static_cast<std::size_t>(max_levels);
+  std::vector<std::vector<int>> best(L_max + 1, std::vector<int>(W, 0)), from = best;
+  for (int b = 0; b < B; ++b) best[1][static_cast<std::size_t>(b) + 1] = count(0, b);
+  for (std::size_t L = 2; L <= L_max; ++L)
+    for (int b = 0; b < B; ++b) {
+      const auto e = static_cast<std::size_t>(b) + 1;
+      best[L][e] = best[L - 1][e], from[L][e] = from[L - 1][e];
+      for (int a = 1; a <= b; ++a) {
+        const int v = best[L - 1][static_cast<std::size_t>(a)] + count(a, b);
+        if (v > best[L][e]) best[L][e] = v, from[L][e] = a;
+      }
+    }
+  // As few levels as come within 2 % of the most: each is printed apart, like a band.
+  std::size_t L = 1;
+  const auto end = static_cast<std::size_t>(B);
+  while (L < L_max && best[L][end] < best[L_max][end] - 0.02 * static_cast<double>(n)) ++L;
+  out.banded = 1.0 - best[L][end] / static_cast<double>(n);
+  // The ranges, last first.
+  std::vector<std::pair<int, int>> ranges;
+  for (int b = B - 1; L >= 1 && b >= 0; --L) {
+    const int a = L == 1 ? 0 : from[L][static_cast<std::size_t>(b) + 1];
+    ranges.emplace_back(a, b);
+    b = a - 1;
+    if (b < 0) break;
+  }
+  std::reverse(ranges.begin(), ranges.end());
+  for (const auto& [a, b] : ranges) {
+    out.levels.z.push_back(top_lo[static_cast<std::size_t>(b)]);
+    out.levels.last.push_back(b);
+  }
+  return out;
+}
+
+}  // namespace nonplanar::layers
