@@ -22,11 +22,40 @@ Notice planar_notice(int patch, const std::string& why) {
           "patch " + std::to_string(patch) + " printed planar: " + why};
 }
 
-// One attempt with the patches not in `excluded`. When no stack can be built and `deferred` is
-// given, it is set and the result is returned unsliced (the caller tries a shell first). On a limit
-// violation inside a curved band, every such band's patch and what it broke are added to *offenders
-// (the caller retries without them; all thickness and slope offenders of one attempt are found at
-// once). Analysis and fitted surfaces: computed once, shared by every attempt.
+// The curved area the patches cover, mm².
+double area_of(const Analysis& a, const std::vector<int>& patches) {
+  double sum = 0;
+  for (int i : patches) sum += a.patches[static_cast<std::size_t>(i)].area;
+  return sum;
+}
+
+// The largest patch that needs curved layers (the patches are sorted by decreasing area), or -1.
+int largest_curved(const Analysis& a) {
+  for (std::size_t i = 0; i < a.patches.size(); ++i)
+    if (a.patches[i].needs_nonplanar()) return static_cast<int>(i);
+  return -1;
+}
+
+// The stacks' patches.
+std::vector<int> stacked_patches(const LayerPlan& plan) {
+  std::vector<int> ids;
+  for (const LayerStack& st : plan.stacks) ids.push_back(st.patch);
+  return ids;
+}
+
+// Whether a shell over the largest curved patch would cover more than twice what the stacks do
+// (shell_over_stacks).
+bool shell_may_cover_more(const Analysis& a, const LayerPlan& plan) {
+  const int largest = largest_curved(a);
+  return largest >= 0 && area_of(a, {largest}) > 2 * area_of(a, stacked_patches(plan));
+}
+
+// One attempt with the patches not in `excluded`. When no stack can be built, or (with
+// defer_small_stacks) the stacks cover less than half the largest curved patch, and `deferred`
+// is given, it is set and the result is returned unsliced (the caller tries a shell first). On a
+// limit violation inside a curved band, every such band's patch and what it broke are added to
+// *offenders (the caller retries without them; all thickness and slope offenders of one attempt are
+// found at once). Analysis and fitted surfaces: computed once, shared by every attempt.
 struct Prepared {
   Analysis analysis;
   std::vector<SurfaceFit> fits;
@@ -37,7 +66,7 @@ struct Prepared {
 Expected<SliceResult> attempt(const TriangleMesh& mesh, const SliceJob& job, const Prepared& pre,
                               const std::vector<int>& excluded,
                               std::vector<std::pair<int, std::string>>* offenders, bool* deferred,
-                              const Context& ctx) {
+                              bool defer_small_stacks, const Context& ctx) {
   offenders->clear();
   if (deferred) *deferred = false;
   SliceResult r;
@@ -74,6 +103,8 @@ Expected<SliceResult> attempt(const TriangleMesh& mesh, const SliceJob& job, con
                                        "no patch can be printed non-planar; slicing planar"});
       // The caller may print it as a shell instead (try_shell): slice planar only if not.
       if (deferred && candidates > 0) return *deferred = true, r;
+    } else if (deferred && defer_small_stacks && shell_may_cover_more(*a, r.plan)) {
+      return *deferred = true, r;  // the caller tries a shell over the largest patch first
     } else {
       auto n = normalize_mesh(mesh, *r.plan.field, {}, ctx);
       if (!n) return n.error();
@@ -205,13 +236,6 @@ Expected<std::optional<SliceResult>> try_shell(const TriangleMesh& mesh, const S
   return std::optional<SliceResult>(std::move(r));
 }
 
-// The curved area the patches cover, mm².
-double area_of(const Analysis& a, const std::vector<int>& patches) {
-  double sum = 0;
-  for (int i : patches) sum += a.patches[static_cast<std::size_t>(i)].area;
-  return sum;
-}
-
 // A part whose stacks follow only a little of its curved top (the CurviSlicer car: 172 mm² of
 // roof, while its 486 mm² body, hollow under the hood, has none): a shell over its largest
 // curved patch instead, if that plans and passes the gate. Stacks follow the top more closely
@@ -221,20 +245,15 @@ double area_of(const Analysis& a, const std::vector<int>& patches) {
 Expected<std::optional<SliceResult>> shell_over_stacks(const TriangleMesh& mesh,
                                                        const SliceJob& job, const Analysis& a,
                                                        SliceResult& stacked, const Context& ctx) {
-  if (stacked.plan.stacks.empty()) return std::optional<SliceResult>{};
-  std::vector<int> ids;
-  for (const LayerStack& st : stacked.plan.stacks) ids.push_back(st.patch);
-  const double covered = area_of(a, ids);
-  int largest = -1;  // the patches are sorted by decreasing area
-  for (std::size_t i = 0; i < a.patches.size() && largest < 0; ++i)
-    if (a.patches[i].needs_nonplanar()) largest = static_cast<int>(i);
-  if (largest < 0 || area_of(a, {largest}) <= 2 * covered) return std::optional<SliceResult>{};
+  if (stacked.plan.stacks.empty() || !shell_may_cover_more(a, stacked.plan))
+    return std::optional<SliceResult>{};
   ctx.progress("shell", 0);
+  const int largest = largest_curved(a);
   const layers::ShellPlan plan = layers::plan_shell(mesh, a, {largest}, job.layers);
   if (!plan.refused.empty()) return std::optional<SliceResult>{};
   char why[160];
   std::snprintf(why, sizeof why, "its %.0f mm² print curved, where stacks would cover %.0f mm²",
-                area_of(a, plan.patches), covered);
+                area_of(a, plan.patches), area_of(a, stacked_patches(stacked.plan)));
   std::vector<Notice> kept = stacked.notices;
   auto shell = try_shell(mesh, job, plan, why, stacked, ctx);
   if (shell && !*shell) stacked.notices = std::move(kept);  // the stacks print: no word of it
@@ -294,11 +313,22 @@ Expected<SliceResult> slice_rounds(const TriangleMesh& mesh, const SliceJob& job
   // OrcaSlicer prints no shells (its command line cannot take our layer boundaries): with it,
   // a part without stacks slices planar at once.
   const bool shells = job.shells && job.engine.engine != Engine::orcaslicer;
+  bool over_stacks_tried = false;
   for (int round = 0; round < 8; ++round) {
     bool deferred = false;
-    auto r = attempt(mesh, job, pre, excluded, &offenders, shells ? &deferred : nullptr, ctx);
+    auto r = attempt(mesh, job, pre, excluded, &offenders, shells ? &deferred : nullptr,
+                     !over_stacks_tried, ctx);
     if (!r) return r;
-    if (deferred) {
+    if (deferred && !r->plan.stacks.empty()) {
+      // Stacks that cover little: a shell over the largest patch first, before they are sliced.
+      over_stacks_tried = true;
+      r->notices.insert(r->notices.begin(), dropped.begin(), dropped.end());
+      auto shell = shell_over_stacks(mesh, job, pre.analysis, *r, ctx);
+      if (!shell) return shell.error();
+      if (*shell) return done(std::move(**shell));
+      r = attempt(mesh, job, pre, excluded, &offenders, nullptr, false, ctx);
+      if (!r) return r;
+    } else if (deferred) {
       // No curved stack: a shell, or else the same attempt sliced planar (its stacks cached).
       r->notices.insert(r->notices.begin(), dropped.begin(), dropped.end());
       ctx.progress("shell", 0);
@@ -309,18 +339,13 @@ Expected<SliceResult> slice_rounds(const TriangleMesh& mesh, const SliceJob& job
       if (!shell) return shell.error();
       if (*shell) return done(std::move(**shell));
       const std::vector<Notice> notices = std::move(r->notices);
-      r = attempt(mesh, job, pre, excluded, &offenders, nullptr, ctx);
+      r = attempt(mesh, job, pre, excluded, &offenders, nullptr, false, ctx);
       if (!r) return r;
       r->notices = notices;
       return done(std::move(r));
     }
     if (offenders.empty()) {
       r->notices.insert(r->notices.begin(), dropped.begin(), dropped.end());
-      if (shells) {
-        auto shell = shell_over_stacks(mesh, job, pre.analysis, *r, ctx);
-        if (!shell) return shell.error();
-        if (*shell) return done(std::move(**shell));
-      }
       return done(std::move(r));
     }
     // A stack that met every limit on its own grid broke one in the final paths: print
