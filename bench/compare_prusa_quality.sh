@@ -4,7 +4,9 @@
 # Usage: bench/compare_prusa_quality.sh [MODEL...]
 # Default models: the end-to-end and coverage issues' analytic solids (written by build/bench/
 # make_test_solids), the shared curved models (wing, FoilCutter, sphere),
-# examples/wave_roof.stl and three shared real parts (ankle base, car, airfoil). Same print both ways: 0.2 mm layers, 0.4 mm nozzle, max_angle 30°.
+# examples/wave_roof.stl and five shared real parts (ankle base, car, airfoil, the Voron
+# ornament, the OpenSCAD heightmap; give the bunny by name: it takes a minute). Same print
+# both ways: 0.2 mm layers, 0.4 mm nozzle, max_angle 30°.
 # Installs prusa-slicer through scripts/setup.sh if needed, and builds.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -20,7 +22,9 @@ if ((${#models[@]} == 0)); then
           ../shared/models/np_curvislicer_wing.stl
           ../shared/models/np_curvislicer_FoilCutter.stl ../shared/models/np_prusa_sphere.stl
           examples/wave_roof.stl ../shared/models/np_curvislicer_anklebase_small.stl
-          ../shared/models/np_curvislicer_car_med.stl ../shared/models/np_curvislicer_airfoil.stl)
+          ../shared/models/np_curvislicer_car_med.stl ../shared/models/np_curvislicer_airfoil.stl
+          ../shared/models/np_voron_sphere_ornament_shellA.stl
+          ../shared/models/np_openscad_example010_heightmap.stl)
 fi
 common=(--layer-height 0.2 --first-layer-height 0.2 --perimeters 2 --top-solid-layers 5
         --bottom-solid-layers 4 --fill-density 20% --fill-pattern rectilinear --skirts 1
