@@ -58,6 +58,11 @@ void stop_engine(pid_t pid, int* status) {
   }
   ::kill(-pid, SIGKILL);
   waitpid(pid, status, 0);
+  // What the engine started is not our child: it dies on its own time, which on a loaded
+  // machine outlasted our exit (a test found its sleep still running). Wait up to 1 s for the
+  // group to go; a zombie that nobody reaps (a container without an init) is not waited for.
+  for (int i = 0; i < 50 && ::kill(-pid, 0) == 0; ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
 }
 
 // Did the engine write its file to the end? Every libslic3r slicer writes its statistics
