@@ -6,7 +6,7 @@
 // no steeper than max_angle}, shrunk by one node at its edge; outside R the core prints every layer
 // whole. d(p) the distance from p to what stands above; a(d) the head's allowance (toolhead.hpp) at
 // distance d from the nozzle; m = h/4; s(p) = L(d(p)) + m the slack, L the largest k-Lipschitz
-// function under a, k = 0.15.
+// function under a, k = 0.12.
 //
 // The order: a point p of shell layer j is given a time τ = clamp(g(U_j(p)), U_j(p) − s⁻(p),
 // U_j(p) + s(p)), s⁻ = min(s, t − a − 0.01) (so the core under p, up to U_0 − (t − a), comes

@@ -239,14 +239,14 @@ Expected<std::optional<SliceResult>> try_shell(const TriangleMesh& mesh, const S
 // A part whose stacks follow only a little of its curved top (the CurviSlicer car: 172 mm² of
 // roof, while its 486 mm² body, hollow under the hood, has none): a shell over its largest
 // curved patch instead, if that plans and passes the gate. Stacks follow the top more closely
-// and cost no bands, so the patch must be more than twice their area. Only the largest alone:
-// planning costs about a second on a large part (0.6 s more on the bunny), and more patches
-// together were refused on every part tried (the Voron ornament, the bunny, the spiky block).
+// and cost no bands, so the patch must be more than twice their area (shell_may_cover_more:
+// `stacked` is an attempt it deferred, its stacks planned but not sliced; none returned: the
+// caller slices them). Only the largest alone: planning costs about a second on a large part,
+// and all curved patches together were refused on every part tried (the Voron ornament, the
+// bunny, the spiky block).
 Expected<std::optional<SliceResult>> shell_over_stacks(const TriangleMesh& mesh,
                                                        const SliceJob& job, const Analysis& a,
                                                        SliceResult& stacked, const Context& ctx) {
-  if (stacked.plan.stacks.empty() || !shell_may_cover_more(a, stacked.plan))
-    return std::optional<SliceResult>{};
   ctx.progress("shell", 0);
   const int largest = largest_curved(a);
   const layers::ShellPlan plan = layers::plan_shell(mesh, a, {largest}, job.layers);
@@ -254,10 +254,7 @@ Expected<std::optional<SliceResult>> shell_over_stacks(const TriangleMesh& mesh,
   char why[160];
   std::snprintf(why, sizeof why, "its %.0f mm² print curved, where stacks would cover %.0f mm²",
                 area_of(a, plan.patches), area_of(a, stacked_patches(stacked.plan)));
-  std::vector<Notice> kept = stacked.notices;
-  auto shell = try_shell(mesh, job, plan, why, stacked, ctx);
-  if (shell && !*shell) stacked.notices = std::move(kept);  // the stacks print: no word of it
-  return shell;
+  return try_shell(mesh, job, plan, why, stacked, ctx);
 }
 
 }  // namespace
