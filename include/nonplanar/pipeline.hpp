@@ -68,6 +68,8 @@ struct SliceResult {
   int curved_patches = 0;  ///< patches whose surface needs curved layers (0 with planar_only)
   int printed_curved = 0;  ///< of those, the ones printed curved (as stacks or in the shell)
   PrintStats stats;        ///< time and filament of `gcode` (with_print_stats)
+  /// `gcode` carries them already: the gate measured them beside its collision search.
+  bool stats_in_gcode = false;
   /// The whole program, as the safety gate checked it: the built-in writer's, or an external
   /// engine's (its start and end G-code and settings kept) mapped back. Write it with
   /// write_gcode_text.

@@ -112,6 +112,13 @@ struct GcodeProgram {
 /// (G28, G29) too, marked moves_head.
 GcodeProgram read_gcode_program(std::string_view text);
 
+/// The same reading, streamed line by line for a caller that needs every line but not all of
+/// them at once (the statistics of a large file): f gets each line in order, with its move
+/// when it is one (else null); the views point into `text`. Returns the program without its
+/// lines and moves (print_begin, print_end, problems and the per-file figures).
+GcodeProgram for_each_gcode_line(std::string_view text,
+                                 const std::function<void(const GcodeLine&, const GcodeMove*)>& f);
+
 /// One G0/G1 move with what it deposited (check's input).
 struct PrintMove {
   Vec3 from{0, 0, 0}, to{0, 0, 0};

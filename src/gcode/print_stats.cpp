@@ -96,16 +96,31 @@ PrintStats print_stats(const GcodeProgram& program, const PrintConfig& c, PrintT
 }
 
 std::string with_print_stats(std::string_view gcode, const PrintConfig& c, PrintStats* stats) {
-  const GcodeProgram program = read_gcode_program(gcode);
-  PrintTime t;
-  const PrintStats s = print_stats(program, c, &t);
-  const double filament = s.filament_mm, cm3 = s.filament_cm3, grams = s.filament_g;
+  // Read once, streamed: the time (and the MK3S's stealth mode's, PrusaSlicer's "silent
+  // mode": its own estimate and progress) and the net E of every move.
+  const bool silent = silent_mode_estimate(c);
+  PrintTimer normal(machine_limits(c)), stealth(machine_limits(c, silent ? 1 : 0));
+  std::size_t lines = 1, moves = 0;  // at most
+  for (std::size_t k = 0; k < gcode.size(); ++k)
+    if (gcode[k] == '\n') ++lines, moves += k + 1 < gcode.size() && (gcode[k + 1] | 0x20) == 'g';
+  normal.reserve(lines, moves + 1);
+  if (silent) stealth.reserve(lines, moves + 1);
+  double filament = 0;  // net: a retraction and its restore cancel
+  const GcodeProgram program =
+      for_each_gcode_line(gcode, [&](const GcodeLine& l, const GcodeMove* m) {
+        normal.line(l, m);
+        if (silent) stealth.line(l, m);
+        if (m) filament += m->de;
+      });
+  const PrintTime t = normal.finish();
+  const PrintTime ts = silent ? stealth.finish() : PrintTime{};
+  filament = std::max(0.0, filament);
+  const double d = c.gcode.filament_diameter;
+  const double cm3 = filament * M_PI * 0.25 * d * d / 1000.0;
+  const double grams = cm3 * first_number(c, "filament_density").value_or(0);
+  if (stats) *stats = PrintStats{t.total, filament, cm3, grams};
   const auto cost_per_kg = first_number(c, "filament_cost");
   const bool progress = first_number(c, "remaining_times").value_or(0) != 0;
-  if (stats) *stats = s;
-  // The MK3S's stealth mode (PrusaSlicer's "silent mode"): its own estimate and progress.
-  const bool silent = silent_mode_estimate(c);
-  const PrintTime ts = silent ? estimate_print_time(program, machine_limits(c, 1)) : PrintTime{};
   auto progress_at = [&](std::size_t i) {
     return progress_line(t.line_start[i], t.total) +
            (silent ? progress_line(ts.line_start[i], ts.total, true) : std::string());
@@ -139,8 +154,14 @@ std::string with_print_stats(std::string_view gcode, const PrintConfig& c, Print
     finish();
     if (!placed) out += block, placed = true;
   };
-  for (std::size_t i = 0; i < program.lines.size(); ++i) {
-    const std::string_view l = program.lines[i].raw;
+  // The lines again, as the reader split them (no line ends, a CR dropped).
+  std::size_t i = 0;
+  for (std::size_t start = 0; start < gcode.size(); ++i) {
+    std::size_t end = gcode.find('\n', start);
+    if (end == std::string_view::npos) end = gcode.size();
+    std::string_view l = gcode.substr(start, end - start);
+    start = end + 1;
+    if (!l.empty() && l.back() == '\r') l.remove_suffix(1);
     if (l == "; prusaslicer_config = begin") place();
     if (is_stat_line(l)) {
       if (l.rfind("; ", 0) == 0) place();

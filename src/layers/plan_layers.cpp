@@ -159,30 +159,38 @@ Expected<LayerPlan> plan_layers(const TriangleMesh& mesh, const Analysis& analys
     return Error{Status::invalid_argument, "plan_layers: one patch index per fit expected"};
   const PlanarLayers planar{params.first_layer_height, params.layer_height};
   const ColumnCaster columns(mesh);
-  LayerPlan plan;
-  std::vector<Band> bands;
-  for (std::size_t i = 0; i < fits.size(); ++i) {
-    if (ctx.cancelled()) return Error{Status::cancelled, "cancelled"};
-    const int pid = patch_of_fit[i];
+  for (const int pid : patch_of_fit)
     if (pid < 0 || pid >= static_cast<int>(analysis.patches.size()))
       return Error{Status::invalid_argument, "plan_layers: patch index out of range"};
-    auto& built = cache.impl().built;
-    auto it = built.find(pid);
-    if (it == built.end())
-      it = built
-               .emplace(pid, layers::build_stack(mesh, analysis.patches[pid], pid, fits[i].surface,
-                                                 columns, params, planar, 1.0, ctx))
-               .first;
-    // A stack whose optimiser was stopped is not the plan's (nor the cache's).
-    if (ctx.cancelled()) return built.erase(it), Error{Status::cancelled, "cancelled"};
-    layers::StackResult r = it->second;
+  // The stacks not built yet, built side by side: each depends only on its own patch and
+  // surface, so the plan does not depend on the thread count (the bunny's 25 took 2.0 s one
+  // after another). A stack whose optimiser was stopped is not the plan's (nor the cache's).
+  auto& built = cache.impl().built;
+  std::vector<std::size_t> missing;
+  for (std::size_t i = 0; i < fits.size(); ++i)
+    if (!built.count(patch_of_fit[i])) missing.push_back(i);
+  std::vector<layers::StackResult> fresh(missing.size());
+  core::parallel_for(std::size_t{0}, missing.size(), [&](std::size_t k) {
+    if (ctx.cancelled()) return;
+    const std::size_t i = missing[k];
+    const int pid = patch_of_fit[i];
+    fresh[k] = layers::build_stack(mesh, analysis.patches[static_cast<std::size_t>(pid)], pid,
+                                   fits[i].surface, columns, params, planar, 1.0, ctx);
+  });
+  if (ctx.cancelled()) return Error{Status::cancelled, "cancelled"};
+  for (std::size_t k = 0; k < missing.size(); ++k)
+    built.emplace(patch_of_fit[missing[k]], std::move(fresh[k]));
+  ctx.progress("layers", 0.8);
+  LayerPlan plan;
+  std::vector<Band> bands;
+  for (const int pid : patch_of_fit) {
+    layers::StackResult r = built.at(pid);
     if (!r.failure.empty()) {
       plan.fallbacks.push_back({pid, r.failure});
     } else {
       plan.stacks.push_back(std::move(r.stack));
       bands.push_back(std::move(r.band));
     }
-    ctx.progress("layers", 0.8 * static_cast<double>(i + 1) / static_cast<double>(fits.size()));
   }
   // Check each blend zone in the field of all bands; drop offenders until none is left.
   for (bool changed = true; changed;) {

@@ -166,15 +166,19 @@ double printability_cost(const StackGrid& g, const Eigen::MatrixXd& Z, const Cos
     if (grad) *grad += part_grad[ch];
   }
   // Heater block: a layer may not rise more than H within the block radius. Only the
-  // intermediate layers are free; the top is the part and the bottom is flat.
+  // intermediate layers are free; the top is the part and the bottom is flat. Layer i's terms
+  // touch only row i − 1 of the gradient, so the layers go in parallel; their sums are added
+  // in layer order (the bunny's largest patch: 91 layers × 42698 pairs, 100 iterations).
   if (pairs) {
-    for (int i = 1; i + 1 < L; ++i)
+    std::vector<double> layer_cost(static_cast<std::size_t>(L), 0.0);
+    core::parallel_for(1, L - 1, [&](int i) {
+      const double* Si = &all[static_cast<std::size_t>(i) * n];
+      double sum = 0;
       for (const auto& [k, l] : g.block_pairs) {
-        const double* Si = &all[static_cast<std::size_t>(i) * n];
         const double over = Si[l] - Si[k] - c.clearance;
         if (over <= 0) continue;
         const double w = g.area[k];
-        cost += w * c.mu * over * over;
+        sum += w * c.mu * over * over;
         if (!grad) continue;
         const double d = 2 * w * c.mu * over;
         for (int a = 0; a < g.m; ++a) {
@@ -182,6 +186,9 @@ double printability_cost(const StackGrid& g, const Eigen::MatrixXd& Z, const Cos
           (*grad)(i - 1, g.control(k, a)) -= d * g.R[static_cast<std::size_t>(k) * g.m + a];
         }
       }
+      layer_cost[static_cast<std::size_t>(i)] = sum;
+    });
+    for (int i = 1; i + 1 < L; ++i) cost += layer_cost[static_cast<std::size_t>(i)];
   }
   return cost;
 }

@@ -51,4 +51,20 @@ GateZones gate_zones(const layers::BandedField& field, double R) {
   return g;
 }
 
+OutOfOrder out_of_order(const std::vector<LayerToolpaths>& layers) {
+  // Between two path points z is linear, so a point between them is below the highest point
+  // before it only if one of them is: their heights bound every sample's.
+  OutOfOrder o;
+  double highest = -1e300;
+  for (std::size_t i = 0; i < layers.size(); ++i)
+    for (const ExtrusionPath& p : layers[i].paths)
+      for (const Vec3& v : p.points) {
+        if (v.z() < highest)
+          o.lo = std::min(o.lo, v.z()), o.hi = std::max(o.hi, v.z()),
+          o.last_layer = static_cast<int>(i);
+        highest = std::max(highest, v.z());
+      }
+  return o;
+}
+
 }  // namespace nonplanar

@@ -34,4 +34,17 @@ struct GateZones {
 /// The zones of every band of `field`; R in mm.
 GateZones gate_zones(const layers::BandedField& field, double R);
 
+/// Heights where a point may meet earlier material, for a program without bands (a shell
+/// over a planar core): material printed before a point and no higher than it cannot reach
+/// into the head, so only the points lower than the highest point printed before them count
+/// (the same layer's included, which only adds points). [lo, hi] spans those points' heights
+/// in `layers` (print order); lo > hi: there are none. The material such a point can meet lies
+/// above lo, and was printed no later than last_layer, the last layer with such a point (-1:
+/// none). In mm.
+struct OutOfOrder {
+  double lo = 1e300, hi = -1e300;
+  int last_layer = -1;
+};
+OutOfOrder out_of_order(const std::vector<LayerToolpaths>& layers);
+
 }  // namespace nonplanar

@@ -342,7 +342,9 @@ Expected<PostProcessed> post_process_gcode(std::string_view gcode, const PrintPl
                      "--check-with prusaslicer and this profile: the patches its paths break "
                      "then stay planar)"};
   PostProcessed out;
-  out.gcode = with_print_stats(r.gcode, *cfg, &out.stats);
+  // The gate measured them (job.print is *cfg).
+  out.gcode = r.stats_in_gcode ? std::move(r.gcode) : with_print_stats(r.gcode, *cfg, &out.stats);
+  if (r.stats_in_gcode) out.stats = r.stats;
   out.moved = moved;
   out.layers = r.layers.size();
   out.thickness_min = r.thickness_min, out.thickness_max = r.thickness_max;

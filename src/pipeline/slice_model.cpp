@@ -392,8 +392,10 @@ Expected<SliceResult> slice_model(const TriangleMesh& mesh, const SliceJob& job,
   if (auto w = write_program(*r, job, ctx); !w) return w.error();
   // Time, progress and filament of the file as written, by either engine (an engine's own
   // were for the flattened part).
-  ctx.progress("stats", 0);
-  r->gcode = with_print_stats(r->gcode, job.print, &r->stats);
+  if (!r->stats_in_gcode) {
+    ctx.progress("stats", 0);
+    r->gcode = with_print_stats(r->gcode, job.print, &r->stats);
+  }
   r->notices.insert(r->notices.begin(), job.notices.begin(), job.notices.end());
   return r;
 }

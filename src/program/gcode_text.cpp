@@ -1,5 +1,6 @@
 #include "program/gcode_text.hpp"
 
+#include <charconv>
 #include <cmath>
 #include <cstdarg>
 #include <cstdio>
@@ -7,12 +8,15 @@
 namespace nonplanar::program {
 namespace {
 
-// Appends one formatted word; false when it would not fit a line.
-bool word(std::string& s, const char* fmt, double v) {
+// Appends " <letter><v>" with `digits` decimals, as printf's %.<digits>f writes it (to_chars
+// with a precision is specified so), in a fraction of its time: printf was half of writing
+// the bunny's 700 000 lines. False when it would not fit a line.
+bool word(std::string& s, char letter, double v, int digits) {
   char buf[64];
-  const int n = std::snprintf(buf, sizeof buf, fmt, v);
-  if (n < 0 || n >= static_cast<int>(sizeof buf)) return false;
-  s += buf;
+  buf[0] = ' ', buf[1] = letter;
+  const auto r = std::to_chars(buf + 2, buf + sizeof buf, v, std::chars_format::fixed, digits);
+  if (r.ec != std::errc()) return false;
+  s.append(buf, r.ptr);
   return true;
 }
 
@@ -32,11 +36,11 @@ void GcodeText::line(const char* fmt, ...) {
 void GcodeText::move(const Vec3& p, const MoveWords& w) {
   std::string s = "G1";
   bool fits = true;
-  if (w.xy) fits = word(s, " X%.3f", p.x()) && word(s, " Y%.3f", p.y());
-  if (w.z) fits = fits && word(s, " Z%.3f", p.z());
+  if (w.xy) fits = word(s, 'X', p.x(), 3) && word(s, 'Y', p.y(), 3);
+  if (w.z) fits = fits && word(s, 'Z', p.z(), 3);
   if (!std::isnan(w.de)) {
     e_ += w.de;
-    fits = fits && word(s, " E%.5f", rel_e_ ? w.de : e_);
+    fits = fits && word(s, 'E', rel_e_ ? w.de : e_, 5);
   }
   if (!std::isnan(w.f)) {
     char buf[32];

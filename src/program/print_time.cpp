@@ -188,37 +188,61 @@ double dwell(std::string_view raw) {
 
 }  // namespace
 
-PrintTime estimate_print_time(const GcodeProgram& program, const MachineLimits& limits) {
-  Limits L(limits);
+struct PrintTimer::Impl {
+  explicit Impl(const MachineLimits& m) : L(m) {}
+  Limits L;
   Previous prev;
   std::vector<Block> blocks;
-  std::vector<double> extra(program.lines.size(), 0.0);  // dwells
-  for (std::size_t i = 0; i < program.lines.size(); ++i) {
-    const GcodeLine& l = program.lines[i];
-    if (l.kind == GcodeLine::Kind::move) {
-      Block b;
-      if (make_block(program.moves[static_cast<std::size_t>(l.move)], L, prev, blocks.empty(), b))
-        b.line = i, blocks.push_back(b);
-    } else if (l.kind == GcodeLine::Kind::text && !l.raw.empty()) {
-      L.read(l.raw);
-      extra[i] = dwell(l.raw);
-    }
+  std::vector<double> extra;  // per line: its dwell
+};
+
+PrintTimer::PrintTimer(const MachineLimits& limits) : impl_(std::make_unique<Impl>(limits)) {}
+PrintTimer::~PrintTimer() = default;
+
+void PrintTimer::reserve(std::size_t lines, std::size_t moves) {
+  impl_->extra.reserve(lines);
+  impl_->blocks.reserve(moves);
+}
+
+void PrintTimer::line(const GcodeLine& l, const GcodeMove* move) {
+  Impl& s = *impl_;
+  const std::size_t i = s.extra.size();
+  s.extra.push_back(0.0);
+  if (l.kind == GcodeLine::Kind::move && move) {
+    Block b;
+    if (make_block(*move, s.L, s.prev, s.blocks.empty(), b)) b.line = i, s.blocks.push_back(b);
+  } else if (l.kind == GcodeLine::Kind::text && !l.raw.empty()) {
+    s.L.read(l.raw);
+    s.extra[i] = dwell(l.raw);
   }
+}
+
+PrintTime PrintTimer::finish() {
+  Impl& s = *impl_;
+  std::vector<Block>& blocks = s.blocks;
   plan(blocks);
-  std::vector<double> spent(program.lines.size(), 0.0);
+  std::vector<double>& spent = s.extra;  // dwells, and now each line's moves too
   for (std::size_t k = 0; k < blocks.size(); ++k) {
     const double exit = k + 1 < blocks.size() ? blocks[k + 1].entry : blocks[k].safe;
     spent[blocks[k].line] += blocks[k].time(exit);
   }
   PrintTime t;
-  t.line_start.resize(program.lines.size() + 1);
+  t.line_start.resize(spent.size() + 1);
   double at = 0;
-  for (std::size_t i = 0; i < program.lines.size(); ++i) {
+  for (std::size_t i = 0; i < spent.size(); ++i) {
     t.line_start[i] = at;
-    at += spent[i] + extra[i];
+    at += spent[i];
   }
   t.line_start.back() = t.total = at;
   return t;
+}
+
+PrintTime estimate_print_time(const GcodeProgram& program, const MachineLimits& limits) {
+  PrintTimer timer(limits);
+  for (const GcodeLine& l : program.lines)
+    timer.line(l, l.kind == GcodeLine::Kind::move ? &program.moves[static_cast<std::size_t>(l.move)]
+                                                  : nullptr);
+  return timer.finish();
 }
 
 std::string format_duration(double seconds) {

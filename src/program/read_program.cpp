@@ -74,7 +74,9 @@ void for_each_line(std::string_view text, F&& f) {
 class Reader {
  public:
   using Sink = std::function<void(const GcodeMove&)>;
-  Reader(GcodeProgram& p, const Sink* sink) : p_(p), sink_(sink) {}
+  using LineSink = std::function<void(const GcodeLine&, const GcodeMove*)>;
+  Reader(GcodeProgram& p, const Sink* sink, const LineSink* lines = nullptr)
+      : p_(p), sink_(sink), line_sink_(lines) {}
   void run(std::string_view text);
 
  private:
@@ -91,7 +93,10 @@ class Reader {
 
   GcodeProgram& p_;
   const Sink* sink_;
+  const LineSink* line_sink_;
+  GcodeMove last_;     // with line_sink_: the move of the line being read
   std::size_t n_ = 0;  // lines in the file
+  std::size_t g_ = 0;  // lines that start with a G: room for the moves, reserved once
   int line_ = 0;
   Vec3 pos_{0, 0, 0};
   GcodeState s_;
@@ -104,12 +109,16 @@ class Reader {
 
 void Reader::run(std::string_view text) {
   find_print(text);
-  if (!sink_) p_.lines.reserve(n_);
+  // Reserved: grown by doubling, the bunny's 700 000 lines were copied over and over, and the
+  // pages of each new block faulted in (a third of the reading).
+  const bool keep = !sink_ && !line_sink_;
+  if (keep) p_.lines.reserve(n_), p_.moves.reserve(g_);
   for_each_line(text, [&](std::size_t i, std::string_view l) {
     GcodeLine item;
     item.raw = l;
     read_line(i, item);
-    if (!sink_) p_.lines.push_back(item);
+    if (line_sink_) (*line_sink_)(item, item.kind == Kind::move ? &last_ : nullptr);
+    if (keep) p_.lines.push_back(item);
   });
 }
 
@@ -118,6 +127,7 @@ void Reader::find_print(std::string_view text) {
   std::vector<std::size_t> custom;  // the ;TYPE:Custom lines
   for_each_line(text, [&](std::size_t i, std::string_view l) {
     n_ = i + 1;
+    g_ += !l.empty() && upper(l[0]) == 'G';
     if (begin == std::string_view::npos && l.rfind(";LAYER_CHANGE", 0) == 0) begin = i;
     if (l.rfind(";TYPE:Custom", 0) == 0)
       custom.push_back(i);
@@ -291,6 +301,7 @@ void Reader::move(core::Tokenizer& tok, GcodeLine& item, bool in_print) {
   m.height = bead_h_;
   item.kind = Kind::move;
   if (sink_) return (*sink_)(m);
+  if (line_sink_) return void(last_ = m);
   item.move = static_cast<int>(p_.moves.size());
   p_.moves.push_back(m);
 }
@@ -307,6 +318,13 @@ PrintMove print_move(const GcodeMove& g) {
 GcodeProgram read_gcode_program(std::string_view text) {
   GcodeProgram p;
   Reader(p, nullptr).run(text);
+  return p;
+}
+
+GcodeProgram for_each_gcode_line(std::string_view text,
+                                 const std::function<void(const GcodeLine&, const GcodeMove*)>& f) {
+  GcodeProgram p;
+  Reader(p, nullptr, &f).run(text);
   return p;
 }
 

@@ -133,5 +133,36 @@ TEST(PrintStats, SilentModeHasItsOwnEstimateAndProgress) {
   }
 }
 
+// with_print_stats reads a file line by line (for_each_gcode_line into a PrintTimer) instead
+// of holding it read: every line's start time must be the whole program's, to the bit.
+TEST(PrintTime, StreamedLineByLineIsTheWholeProgramsEstimate) {
+  std::string in = "M201 X900 Y900\nM204 S800 T1200\nG90\nM83\nG92 E0\n";
+  for (int k = 0; k < 200; ++k) {
+    in += ";LAYER_CHANGE\n;Z:" + std::to_string(0.2 * (k + 1)) + "\n";
+    in += "G1 Z" + std::to_string(0.2 * (k + 1)) + " F600\n";
+    in += "G1 X" + std::to_string(10 + k % 7) + " Y" + std::to_string(20 + k % 5) + " E0.4 F1800\n";
+    in += "G1 X30 Y" + std::to_string(5 + k % 3) + " E0.9\nG1 E-0.8 F2100\n";
+    if (k % 50 == 0) in += "G4 P250\nM205 X8 Y8\n";
+  }
+  const GcodeProgram whole = read_gcode_program(in);
+  const PrintTime want = estimate_print_time(whole, MachineLimits{});
+  PrintTimer timer(MachineLimits{});
+  const GcodeProgram skeleton =
+      for_each_gcode_line(in, [&](const GcodeLine& l, const GcodeMove* m) {
+        EXPECT_EQ(m != nullptr, l.kind == GcodeLine::Kind::move);
+        timer.line(l, m);
+      });
+  const PrintTime got = timer.finish();
+  EXPECT_GT(want.total, 10);
+  EXPECT_EQ(got.total, want.total);
+  ASSERT_EQ(got.line_start.size(), whole.lines.size() + 1);
+  EXPECT_EQ(got.line_start, want.line_start);
+  // The skeleton keeps the per-file figures, not the lines.
+  EXPECT_EQ(skeleton.print_begin, whole.print_begin);
+  EXPECT_EQ(skeleton.print_end, whole.print_end);
+  EXPECT_TRUE(skeleton.lines.empty());
+  EXPECT_TRUE(skeleton.moves.empty());
+}
+
 }  // namespace
 }  // namespace nonplanar
