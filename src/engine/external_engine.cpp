@@ -44,9 +44,11 @@ struct TempDir {
   }
 };
 
-// The engine's process group while it runs (its own group, so that a terminal's Ctrl-C
-// reaches us, not it, and we stop it with everything it started), for kill_running_engine().
-std::atomic<pid_t> g_engine_group{0};
+// The engines' process groups while they run (each its own group, so that a terminal's Ctrl-C
+// reaches us, not them, and we stop each with everything it started), for
+// kill_running_engine(): a slot each, as a shell's two runs go side by side.
+constexpr int kEngineSlots = 4;
+std::atomic<pid_t> g_engine_group[kEngineSlots]{};
 
 // Stops the engine's whole group: SIGTERM, and SIGKILL if it has not gone within 3 s (an
 // engine that ignored SIGTERM once kept running, and kept its folder, after Ctrl-C).
@@ -270,10 +272,16 @@ Expected<std::string> run_engine(const EngineParams& e, const TriangleMesh& mesh
   const int rc = posix_spawnp(&pid, exe.c_str(), &fa, &attr, argv.data(), environ);
   posix_spawn_file_actions_destroy(&fa);
   posix_spawnattr_destroy(&attr);
-  if (rc == 0) g_engine_group.store(pid);
+  std::atomic<pid_t>* slot = nullptr;
+  for (int i = 0; rc == 0 && i < kEngineSlots && !slot; ++i)
+    if (pid_t none = 0; g_engine_group[i].compare_exchange_strong(none, pid))
+      slot = &g_engine_group[i];
   struct Forget {
-    ~Forget() { g_engine_group.store(0); }
-  } forget;
+    std::atomic<pid_t>* slot;
+    ~Forget() {
+      if (slot) slot->store(0);
+    }
+  } forget{slot};
   if (rc != 0)
     return Error{Status::io_error, "engine: cannot run '" + exe + "' (" + name +
                                        " not installed? --engine-path names it)"};
@@ -313,10 +321,10 @@ Expected<std::string> run_engine(const EngineParams& e, const TriangleMesh& mesh
 }
 
 bool kill_running_engine() {
-  const pid_t g = g_engine_group.load();
-  if (g <= 0) return false;
-  ::kill(-g, SIGKILL);
-  return true;
+  bool any = false;
+  for (std::atomic<pid_t>& slot : g_engine_group)
+    if (const pid_t g = slot.load(); g > 0) ::kill(-g, SIGKILL), any = true;
+  return any;
 }
 
 }  // namespace nonplanar

@@ -40,8 +40,9 @@ std::vector<std::string> engine_shell_settings(double first_layer);
 /// SIGKILL after 3 s). Errors: io_error (engine missing, failed: its last output line; a
 /// file without the statistics or config block a slicer writes after the last layer, i.e.
 /// truncated), cancelled.
-/// For a signal handler (async-signal-safe): SIGKILL the running engine's process group, if
-/// one runs; run_engine() then returns and removes its folder. True if there was one.
+/// For a signal handler (async-signal-safe): SIGKILL the running engines' process groups (a
+/// shell's two runs go side by side); each run_engine() then returns and removes its folder.
+/// True if one ran.
 bool kill_running_engine();
 
 Expected<std::string> run_engine(const EngineParams& e, const TriangleMesh& mesh,
