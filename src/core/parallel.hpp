@@ -72,7 +72,15 @@ class Background {
   Background() = default;
   Background(const Background&) = delete;
   Background& operator=(const Background&) = delete;
-  ~Background() { wait(); }
+  /// Waits too; what the task threw is then dropped (a destructor must not throw, and on the
+  /// way out of an error the caller's own exception is the one that counts): call wait() to
+  /// have it.
+  ~Background() {
+    try {
+      wait();
+    } catch (...) {
+    }
+  }
   template <class F>
   void run(F&& f) {
 #ifdef NONPLANAR_TSAN
@@ -81,10 +89,13 @@ class Background {
     group_.run(std::forward<F>(f));
 #endif
   }
+  /// Waits for the tasks; rethrows what one threw (std::bad_alloc under --max-memory).
   void wait() {
 #ifdef NONPLANAR_TSAN
-    for (auto& t : tasks_) t.wait();
+    std::vector<std::future<void>> tasks = std::move(tasks_);
     tasks_.clear();
+    for (auto& t : tasks) t.wait();
+    for (auto& t : tasks) t.get();
 #else
     group_.wait();
 #endif

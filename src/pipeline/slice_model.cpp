@@ -29,13 +29,6 @@ double area_of(const Analysis& a, const std::vector<int>& patches) {
   return sum;
 }
 
-// The largest patch that needs curved layers (the patches are sorted by decreasing area), or -1.
-int largest_curved(const Analysis& a) {
-  for (std::size_t i = 0; i < a.patches.size(); ++i)
-    if (a.patches[i].needs_nonplanar()) return static_cast<int>(i);
-  return -1;
-}
-
 // The stacks' patches.
 std::vector<int> stacked_patches(const LayerPlan& plan) {
   std::vector<int> ids;
@@ -43,15 +36,17 @@ std::vector<int> stacked_patches(const LayerPlan& plan) {
   return ids;
 }
 
-// Whether a shell over the largest curved patch would cover more than twice what the stacks do
-// (shell_over_stacks).
+// Whether a shell could cover more than twice what the stacks do: all curved patches together
+// must (shell_over_stacks then asks it of the shell it plans).
 bool shell_may_cover_more(const Analysis& a, const LayerPlan& plan) {
-  const int largest = largest_curved(a);
-  return largest >= 0 && area_of(a, {largest}) > 2 * area_of(a, stacked_patches(plan));
+  std::vector<int> curved;
+  for (std::size_t i = 0; i < a.patches.size(); ++i)
+    if (a.patches[i].needs_nonplanar()) curved.push_back(static_cast<int>(i));
+  return area_of(a, curved) > 2 * area_of(a, stacked_patches(plan));
 }
 
 // One attempt with the patches not in `excluded`. When no stack can be built, or (with
-// defer_small_stacks) the stacks cover less than half the largest curved patch, and `deferred`
+// defer_small_stacks) the stacks cover less than half the curved patches' area, and `deferred`
 // is given, it is set and the result is returned unsliced (the caller tries a shell first). On a
 // limit violation inside a curved band, every such band's patch and what it broke are added to
 // *offenders (the caller retries without them; all thickness and slope offenders of one attempt are
@@ -237,20 +232,21 @@ Expected<std::optional<SliceResult>> try_shell(const TriangleMesh& mesh, const S
 }
 
 // A part whose stacks follow only a little of its curved top (the CurviSlicer car: 172 mm² of
-// roof, while its 486 mm² body, hollow under the hood, has none): a shell over its largest
-// curved patch instead, if that plans and passes the gate. Stacks follow the top more closely
-// and cost no bands, so the patch must be more than twice their area (shell_may_cover_more:
-// `stacked` is an attempt it deferred, its stacks planned but not sliced; none returned: the
-// caller slices them). Only the largest alone: planning costs about a second on a large part,
-// and all curved patches together were refused on every part tried (the Voron ornament, the
-// bunny, the spiky block).
+// roof, while its 486 mm² body, hollow under the hood, has none): a shell instead, if that
+// plans and passes the gate: over all its curved patches (the car: 1065 mm², 84 % of its
+// curved top within 0.03 mm, where the body alone gave 57 %), else over the largest alone
+// (the bunny and the Voron ornament refuse the whole). Stacks follow the top more closely and
+// cost no bands, so the shell must cover more than twice their area (shell_may_cover_more
+// asks it of all curved patches first; `stacked` is an attempt it deferred, its stacks
+// planned but not sliced; none returned: the caller slices them).
 Expected<std::optional<SliceResult>> shell_over_stacks(const TriangleMesh& mesh,
                                                        const SliceJob& job, const Analysis& a,
                                                        SliceResult& stacked, const Context& ctx) {
   ctx.progress("shell", 0);
-  const int largest = largest_curved(a);
-  const layers::ShellPlan plan = layers::plan_shell(mesh, a, {largest}, job.layers);
-  if (!plan.refused.empty()) return std::optional<SliceResult>{};
+  const layers::ShellPlan plan = layers::choose_shell(mesh, a, job.layers);
+  if (!plan.refused.empty() ||
+      !(area_of(a, plan.patches) > 2 * area_of(a, stacked_patches(stacked.plan))))
+    return std::optional<SliceResult>{};
   char why[160];
   std::snprintf(why, sizeof why, "its %.0f mm² print curved, where stacks would cover %.0f mm²",
                 area_of(a, plan.patches), area_of(a, stacked_patches(stacked.plan)));
@@ -323,6 +319,10 @@ Expected<SliceResult> slice_rounds(const TriangleMesh& mesh, const SliceJob& job
       auto shell = shell_over_stacks(mesh, job, pre.analysis, *r, ctx);
       if (!shell) return shell.error();
       if (*shell) return done(std::move(**shell));
+      // The stacks, then; and why the shell did not print, if it got as far as the gate (kept
+      // through the rounds, as the patches dropped are).
+      for (const Notice& n : r->notices)
+        if (n.kind == Notice::Kind::shell_refused) dropped.push_back(n);
       r = attempt(mesh, job, pre, excluded, &offenders, nullptr, false, ctx);
       if (!r) return r;
     } else if (deferred) {
