@@ -1,6 +1,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <unordered_map>
 #include <unordered_set>
 
@@ -20,6 +21,12 @@ std::uint64_t edge_key(int a, int b) {
 }
 
 }  // namespace
+
+NormalizeParams shell_normalize_params(const TriangleMesh& mesh) {
+  NormalizeParams p;
+  p.max_faces = std::max<std::size_t>(500'000, 4 * mesh.faces.size());
+  return p;
+}
 
 Expected<NormalizedMesh> normalize_mesh(const TriangleMesh& mesh, const LayerField& field,
                                         const NormalizeParams& params, const Context& ctx) {
@@ -113,6 +120,14 @@ Expected<NormalizedMesh> normalize_mesh(const TriangleMesh& mesh, const LayerFie
     }
     for (const auto& [key, v] : mid) split += v >= 0;
     m.faces = std::move(faces);
+    if (params.max_faces > 0 && m.faces.size() > params.max_faces) {
+      char buf[200];
+      std::snprintf(buf, sizeof buf,
+                    "the map onto the curved layers would split the part into more than %zu "
+                    "triangles (its top bends too sharply)",
+                    params.max_faces);
+      return Error{Status::unsupported, buf};
+    }
     final_face = std::move(final_next);
     out.rounds = round + 1;
     out.edges_split += split;

@@ -107,7 +107,7 @@ Expected<EngineShell> shell_with_engine(const TriangleMesh& mesh, const layers::
   core::Background beside;
   beside.run([&] {
     const layers::ShellField field(plan);
-    auto normalized = normalize_mesh(mesh, field, {}, beside_ctx);
+    auto normalized = normalize_mesh(mesh, field, shell_normalize_params(mesh), beside_ctx);
     if (!normalized) return void(shell_text = normalized.error());
     EngineRun shell_run;
     shell_run.slab_layer_height = plan.t;

@@ -164,6 +164,16 @@ Expected<std::vector<LayerToolpaths>> shell_toolpaths(const TriangleMesh& mesh,
   const bool partial = !plan.region.empty();
   const std::vector<ExPolygon> R =
       partial ? layers::region_at_least(plan.region, 0) : std::vector<ExPolygon>{};
+  // The shell: normalised so its layers are the planes ζ = j·t … (j + 1)·t.
+  const layers::ShellField field(plan);
+  // Where the part stands above the top, H carried over it bends the map hard: to 0.005 mm the
+  // ankle base's 1196 faces became 1.8 million in 12 rounds (4.4 s). The slab's contours need
+  // no more than a bead's precision; its points are mapped back exactly.
+  NormalizeParams np = shell_normalize_params(mesh);
+  if (partial) np.tolerance = 0.02, np.max_rounds = 8;
+  auto normalized = normalize_mesh(mesh, field, np, ctx);
+  if (!normalized) return normalized.error();
+  // The core after the shell's map, which may refuse the shell (shell_normalize_params).
   auto core = core_layers(mesh, plan, R, ctx);
   if (!core) return core.error();
   ctx.progress("core", 1.0);
@@ -174,17 +184,8 @@ Expected<std::vector<LayerToolpaths>> shell_toolpaths(const TriangleMesh& mesh,
     core_paths = std::move(*paths);
   }
 
-  // The shell: normalised so its layers are the planes ζ = j·t … (j + 1)·t. An empty layer
-  // first stands for the bed-side neighbour make_toolpaths treats specially (first-layer
-  // width and speed, the skirt): the shell is never the first layer printed.
-  const layers::ShellField field(plan);
-  // Where the part stands above the top, H carried over it bends the map hard: to 0.005 mm the
-  // ankle base's 1196 faces became 1.8 million in 12 rounds (4.4 s). The slab's contours need
-  // no more than a bead's precision; its points are mapped back exactly.
-  NormalizeParams np;
-  if (partial) np.tolerance = 0.02, np.max_rounds = 8;
-  auto normalized = normalize_mesh(mesh, field, np, ctx);
-  if (!normalized) return normalized.error();
+  // An empty layer first stands for the bed-side neighbour make_toolpaths treats specially
+  // (first-layer width and speed, the skirt): the shell is never the first layer printed.
   std::vector<SlicedLayer> shell(static_cast<std::size_t>(plan.N) + 1);
   for (int j = -1; j < plan.N; ++j) {
     SlicedLayer& l = shell[static_cast<std::size_t>(j + 1)];

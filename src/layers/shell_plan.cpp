@@ -5,8 +5,6 @@
 #include <cmath>
 #include <cstdio>
 
-#include "core/parallel.hpp"
-
 namespace nonplanar::layers {
 namespace {
 
@@ -213,17 +211,11 @@ ShellPlan choose_shell(const TriangleMesh& mesh, const Analysis& a, const LayerP
     none.refused = "no patch needs curved layers";
     return none;
   }
-  if (all.size() == 1) return plan_shell(mesh, a, all, p);
-  // Both plans side by side (each about 0.7 s on the bunny, mostly one core's raster work):
-  // the largest alone is wanted whenever all together are refused (the bunny, the ornament).
-  ShellPlan plan, one;
-  {
-    core::Background beside;
-    beside.run([&] { one = plan_shell(mesh, a, {all.front()}, p); });
-    plan = plan_shell(mesh, a, all, p);
-    beside.wait();
+  ShellPlan plan = plan_shell(mesh, a, all, p);
+  if (!plan.refused.empty() && all.size() > 1) {
+    ShellPlan one = plan_shell(mesh, a, {all.front()}, p);
+    if (one.refused.empty()) plan = std::move(one);
   }
-  if (!plan.refused.empty() && one.refused.empty()) plan = std::move(one);
   return plan;
 }
 

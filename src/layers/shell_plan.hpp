@@ -78,7 +78,7 @@ ShellPlan plan_shell(const TriangleMesh& mesh, const Analysis& a, const std::vec
 /// The shell `slice` tries when no stack can be built, or when the stacks cover less than half
 /// the largest curved patch: all the patches that need curved layers as one top, or failing
 /// that the largest alone (refused, with the first reason, when neither fits; patches empty
-/// when none needs curved layers). The two are planned side by side.
+/// when none needs curved layers).
 ShellPlan choose_shell(const TriangleMesh& mesh, const Analysis& a, const LayerParams& p);
 
 /// The shell's layer field: T = N + (z − H)/t, ζ = t·T, so the normalised mesh holds the

@@ -182,17 +182,29 @@ TEST(Layers, OptimiserLeavesAnEvenStackThatMeetsTheLimitsOnItsPatch) {
   EXPECT_EQ(r.stack.optimizer_message.find("kept"), std::string::npos);
 }
 
+// The sine roof, its one patch, the patch's fitted top and the columns: what build_stack
+// takes.
+struct RoofInputs {
+  RoofInputs() {
+    auto fit = fit_patch(mesh, patch(), {}, {});
+    EXPECT_TRUE(fit);
+    if (fit) top = fit->surface;
+  }
+  RoofInputs(const RoofInputs&) = delete;
+  const Patch& patch() const { return analysis.patches[0]; }
+  TriangleMesh mesh = test::sine_roof();
+  Analysis analysis = *analyze(mesh, {}, {});
+  HeightField top;
+  ColumnCaster cols{mesh};
+};
+
 TEST(Layers, OptimiserLowersTheCostOfAPoorStart) {
-  const TriangleMesh m = test::sine_roof();
-  const Analysis a = *analyze(m, {}, {});
-  const auto fit = fit_patch(m, a.patches[0], {}, {});
-  ASSERT_TRUE(fit);
-  const ColumnCaster cols(m);
+  const RoofInputs in;
   LayerParams lp;
   lp.max_iterations = 1000;
   const layers::PlanarLayers planar{lp.first_layer_height, lp.layer_height};
   // a_i = (i/N)³ bunches the layers at the top: thin there, thick below.
-  const auto r = layers::build_stack(m, a.patches[0], 0, fit->surface, cols, lp, planar, 3.0);
+  const auto r = layers::build_stack(in.mesh, in.patch(), 0, in.top, in.cols, lp, planar, 3.0);
   ASSERT_TRUE(r.failure.empty()) << r.failure;
   EXPECT_LT(r.stack.cost_after, 0.5 * r.stack.cost_before);
   EXPECT_GT(r.stack.iterations, 0);
@@ -202,11 +214,11 @@ TEST(Layers, OptimiserLowersTheCostOfAPoorStart) {
   EXPECT_LE(r.stack.thickness_max, lp.max_layer_height + 1e-6);
   // Steepest descent (the paper's eq. 2) also lowers it.
   lp.optimizer = StackOptimizer::gradient_descent;
-  const auto gd = layers::build_stack(m, a.patches[0], 0, fit->surface, cols, lp, planar, 3.0);
+  const auto gd = layers::build_stack(in.mesh, in.patch(), 0, in.top, in.cols, lp, planar, 3.0);
   ASSERT_TRUE(gd.failure.empty()) << gd.failure;
   EXPECT_LT(gd.stack.cost_after, 0.9 * gd.stack.cost_before);
   // The even interpolation is a stationary point of eq. (1): nothing to improve there.
-  const auto even = layers::build_stack(m, a.patches[0], 0, fit->surface, cols, lp, planar, 1.0);
+  const auto even = layers::build_stack(in.mesh, in.patch(), 0, in.top, in.cols, lp, planar, 1.0);
   EXPECT_NEAR(even.stack.cost_after, even.stack.cost_before, 1e-9 * even.stack.cost_before);
   // From the poor start it ends near that optimum: 72.3 against 70.5, 2.5 % over (with the
   // penalties off the patch counted too, both were larger and within 1 % of each other).
@@ -217,7 +229,7 @@ TEST(Layers, OptimiserLowersTheCostOfAPoorStart) {
   cancelled.cancel_flag = &stop;
   lp.optimizer = StackOptimizer::lbfgs;
   const auto c =
-      layers::build_stack(m, a.patches[0], 0, fit->surface, cols, lp, planar, 3.0, cancelled);
+      layers::build_stack(in.mesh, in.patch(), 0, in.top, in.cols, lp, planar, 3.0, cancelled);
   EXPECT_GT(r.stack.iterations, 5);
   EXPECT_LE(c.stack.iterations, 1);
 }
@@ -226,19 +238,15 @@ TEST(Layers, OptimiserLowersTheCostOfAPoorStart) {
 // layers under it (the top is the part's and fixed): the stack is refused before the
 // optimiser runs (the bunny's largest such patch took 100 iterations, 1 s, to be refused).
 TEST(Layers, ATopThatRisesIntoTheHeadIsRefusedBeforeTheOptimiser) {
-  const TriangleMesh m = test::sine_roof();
-  const Analysis a = *analyze(m, {}, {});
-  const auto fit = fit_patch(m, a.patches[0], {}, {});
-  ASSERT_TRUE(fit);
-  const ColumnCaster cols(m);
+  const RoofInputs in;
   LayerParams lp;
   const layers::PlanarLayers planar{lp.first_layer_height, lp.layer_height};
-  const auto fits = layers::build_stack(m, a.patches[0], 0, fit->surface, cols, lp, planar);
+  const auto fits = layers::build_stack(in.mesh, in.patch(), 0, in.top, in.cols, lp, planar);
   ASSERT_TRUE(fits.failure.empty()) << fits.failure;
   const double rise = fits.stack.max_block_rise;  // the top's, the highest of the even stack
   ASSERT_GT(rise, 0.5);
   lp.toolhead.block_clearance = rise - 0.3;
-  const auto r = layers::build_stack(m, a.patches[0], 0, fit->surface, cols, lp, planar);
+  const auto r = layers::build_stack(in.mesh, in.patch(), 0, in.top, in.cols, lp, planar);
   EXPECT_NE(r.failure.find("a layer rises"), std::string::npos) << r.failure;
   // No solver run and no cost evaluated.
   EXPECT_EQ(r.stack.iterations, 0);
