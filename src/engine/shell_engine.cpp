@@ -8,7 +8,6 @@
 #include <cstdio>
 #include <map>
 
-#include "core/parallel.hpp"
 #include "engine/external_engine.hpp"
 #include "nonplanar/deform.hpp"
 
@@ -97,23 +96,6 @@ Expected<EngineShell> shell_with_engine(const TriangleMesh& mesh, const layers::
     return Error{Status::unsupported,
                  "through an engine, a shell prints only where the part stands nowhere above "
                  "its top (the built-in engine prints this one)"};
-  // The shell's run (the normalised mesh's slab 0 <= ζ <= N·t) goes on the other core while
-  // this one runs the core's: the two are independent until the shell is entered from where
-  // the core ended (the wing's pair of PrusaSlicer runs took 0.9 s one after the other). It
-  // reports no progress (reports come from the calling thread) but stops on cancellation.
-  Context beside_ctx;
-  beside_ctx.cancel_flag = ctx.cancel_flag;
-  Expected<std::string> shell_text = Error{Status::internal_error, "shell run not started"};
-  core::Background beside;
-  beside.run([&] {
-    const layers::ShellField field(plan);
-    auto normalized = normalize_mesh(mesh, field, shell_normalize_params(mesh), beside_ctx);
-    if (!normalized) return void(shell_text = normalized.error());
-    EngineRun shell_run;
-    shell_run.slab_layer_height = plan.t;
-    shell_text =
-        run_engine(job.engine, cut_below(normalized->mesh, 0.0), job.print, beside_ctx, shell_run);
-  });
   // The core: the whole mesh sliced on the plan's boundaries (its skins then sit under the
   // real top, so the shell counts as their cover), each layer cut back under the shell.
   EngineRun core_run;
@@ -146,8 +128,16 @@ Expected<EngineShell> shell_with_engine(const TriangleMesh& mesh, const layers::
   }
   ctx.progress("core", 1.0);
 
-  // The shell, entered from where the core ended.
-  beside.wait();
+  // The shell: the normalised mesh's slab 0 <= ζ <= N·t, entered from where the core ended.
+  // (Not beside the core's run: write_file_atomically registers one temporary at a time for
+  // the signal handler, and both runs write their mesh through it.)
+  const layers::ShellField field(plan);
+  auto normalized = normalize_mesh(mesh, field, shell_normalize_params(mesh), ctx);
+  if (!normalized) return normalized.error();
+  EngineRun shell_run;
+  shell_run.slab_layer_height = plan.t;
+  auto shell_text =
+      run_engine(job.engine, cut_below(normalized->mesh, 0.0), job.print, ctx, shell_run);
   if (!shell_text) return shell_text.error();
   const layers::ShellPathField path_field(plan);
   ForeignMapOptions shell_opt;
