@@ -10,6 +10,10 @@ namespace {
 
 constexpr double kDeg = M_PI / 180.0;
 constexpr double kMargin = 0.01;  ///< m: the stairs' thickness stays this far inside the limits
+/// A face whose normal points down by less than this (|n_z| = sin of the wall's lean from the
+/// vertical: 45°) is a wall each layer prints over the one below, as planar slicing does: the
+/// downhill side of a tilted bore under a tilted ring, not an overhang the shell would rest on.
+constexpr double kSelfSupporting = 0.7071;
 
 std::string at(const char* what, const Vec3& p) {
   char buf[200];
@@ -37,9 +41,10 @@ std::vector<double> core_boundaries(double h1, double h_c, double h_min, double 
   return z;
 }
 
-// Overhangs and other printable up-facing surfaces (not of the patches) within `overhang`
-// (overhangs) or half a millimetre (tops) under the shell's bottom, inside R: why the shell
-// cannot rest on the core there, naming the first place (empty when none), and every such face.
+// Overhangs (leaning over 45°) and other printable up-facing surfaces (not of the patches) within
+// `overhang` (overhangs) or half a millimetre (tops) under the shell's bottom, inside R: why the
+// shell cannot rest on the core there, naming the first place (empty when none), and every such
+// face.
 struct Under {
   std::string why;
   std::vector<char> faces;
@@ -58,7 +63,7 @@ Under under_shell(const TriangleMesh& mesh, const std::vector<char>& in_patch, c
     if (!(len > 0)) continue;
     const double nz = nrm.z() / len;
     const bool on_bed = std::max({v[0].z(), v[1].z(), v[2].z()}) < 1e-6;
-    const bool is_overhang = nz < -0.1 && !on_bed;
+    const bool is_overhang = nz < -kSelfSupporting && !on_bed;
     const bool printable_top = nz > cos_max;
     if (!is_overhang && !printable_top) continue;
     const double margin = is_overhang ? overhang : 0.5;
@@ -175,7 +180,10 @@ ShellPlan plan_shell(const TriangleMesh& mesh, const Analysis& a, const std::vec
   // left to the planar core).
   std::vector<char> in_patch(mesh.faces.size(), 0);
   for (int f : P.faces) in_patch[static_cast<std::size_t>(f)] = 1;
-  s.below = s.t - s.reach - 0.01;
+  // s⁻ also bounds how far a shell point printed before a core layer rises over it: under the
+  // check's h/2 with room for the file's rounding (at the defaults t − a − 0.01 was h/2 itself,
+  // and the rib over a void left a shell point 0.100 mm over a later core layer 0.28 mm away).
+  s.below = std::min(s.t - s.reach - 0.01, 0.5 * p.layer_height - 0.01);
   ShellRegion region = shell_region(mesh, in_patch, {}, 0, s.top, s.below, p);
   if (!region.refused.empty()) {
     s.refused = region.refused;

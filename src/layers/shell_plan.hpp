@@ -40,7 +40,7 @@ struct ShellPlan {
   /// s on H's raster, mm (shell_region.hpp); empty: the shell after the whole core.
   FacetedTop slack;
   ShellLevels levels;  ///< g (shell_levels.hpp)
-  double below = 0;    ///< the bound of s⁻, t − a − 0.01, mm
+  double below = 0;    ///< the bound of s⁻, min(t − a, h/2) − 0.01, mm
   /// What of the patches the shell leaves to the core because an overhang or another surface
   /// lies under it there, and why (empty: none).
   std::string left_out;

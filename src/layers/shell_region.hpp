@@ -9,9 +9,10 @@
 // function under a, k = 0.12.
 //
 // The order: a point p of shell layer j is given a time τ = clamp(g(U_j(p)), U_j(p) − s⁻(p),
-// U_j(p) + s(p)), s⁻ = min(s, t − a − 0.01) (so the core under p, up to U_0 − (t − a), comes
-// first), and printed right after core layer k, the last with z_k <= τ (after the whole core
-// when none is above it). g is a non-decreasing step function of a few heights
+// U_j(p) + s(p)), s⁻ = min(s, t − a − 0.01, h/2 − 0.01) (so the core under p, up to
+// U_0 − (t − a), comes first, and p rises less than h/2 over the core printed after it), and
+// printed right after core layer k, the last with z_k <= τ (after the whole core when none is
+// above it; a path whose τ passes several z_k at once is cut at each). g is a non-decreasing step function of a few heights
 // (shell_levels.hpp) that the most of the patch can take, so most of the shell goes at a few
 // times, as a few pieces per layer; next to what stands above, the shell follows the wall up in
 // bands of the core's layer height, with a seam between bands (a shell banded over more than

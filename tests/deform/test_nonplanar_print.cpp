@@ -298,20 +298,30 @@ TEST(NonplanarPrint, SharedCarPrintsAShellWhereItsStacksCoverLittle) {
 }
 
 // The Slic3r spiky block: its stacks cover 154 mm² of a 1342 mm² curved top, so a shell over
-// all of it is tried first. Whatever becomes of the shell, the run says: it prints, or a
-// notice says why it did not (that notice was lost when the stacks were sliced instead).
-TEST(NonplanarPrint, SharedSpikyBlockSaysWhyItsShellDidNotPrint) {
+// all 20 tilted facets is tried first. It was refused ("an extrusion would hit earlier
+// layers"): where the shell's print order g steps across several core layers at once, a piece
+// of path kept the core layers in between and was printed too late, 0.105 mm under a shell
+// point 0.45 mm away. Now it prints: 87 % of the curved top within 0.03 mm (the stacks: 22 %).
+TEST(NonplanarPrint, SharedSpikyBlockPrintsAShellOverAllItsFacets) {
   const auto dir = test::shared_models();
   if (dir.empty()) GTEST_SKIP() << "../shared/models not present";
   auto m = load_mesh(dir / "np_slic3r_nonplanar_spikey_top.stl", {}, {});
   ASSERT_TRUE(m);
-  const Outcome o = run(m->mesh, {}, {});
+  CheckParams cp;
+  cp.min_angle_deg = 2;
+  const Outcome o = run(m->mesh, {}, cp);
+  EXPECT_EQ(o.result.shell_layers, 4);
   EXPECT_EQ(o.figures.collisions, 0u);
-  bool said = false;
+  EXPECT_GT(o.figures.within_share, 0.8);
+  const LayerParams lp = make_job(PrintConfig{}).layers;
+  EXPECT_GE(o.figures.thickness_min, lp.min_layer_height - 1e-3);
+  EXPECT_LE(o.figures.thickness_max, lp.max_layer_height + 1e-3);
+  bool all = false;
   for (const Notice& n : o.result.notices)
-    said |= n.kind == Notice::Kind::shell_refused &&
-            n.text.find("patches 0, 1, 2") != std::string::npos;
-  EXPECT_TRUE(o.result.shell_layers > 0 || said);
+    all |= n.text.find(
+               "patches 0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16, 17, 18, "
+               "19: curved shell") != std::string::npos;
+  EXPECT_TRUE(all);
 }
 
 // At 0.15 mm layers a shell of the profile's layer height put the nozzle tip's flat into

@@ -150,16 +150,24 @@ TEST(ShellPlan, TakesFewerLayersOverAThinWall) {
 }
 
 // The CurviSlicer ankle base: its heel's curved top is ringed by a rim standing above it, so a
-// shell beside the rim would follow it up in bands over 92 % of the top (printed as 402 layers
-// and 1h33m against the planar 85 and 32m): refused, and the part prints planar.
+// shell over both curved patches would follow the rim up in bands over 92 % of the heel (printed
+// as 402 layers and 1h33m against the planar 85 and 32m): refused. The rim's own tilted top
+// gets the shell alone. The tilted bore through it leans under the rim (faces 23° off the
+// vertical, printed over each other as planar layers print them): not an overhang the shell
+// would rest on, which had refused this shell too.
 TEST(ShellPlan, RefusesAShellMostlyPrintedInBands) {
   const auto dir = test::shared_models();
   if (dir.empty()) GTEST_SKIP() << "../shared/models not present";
   auto m = load_mesh(dir / "np_curvislicer_anklebase_small.stl", {}, {});
   ASSERT_TRUE(m);
   const Analysis a = *analyze(m->mesh, {}, {});
-  const std::string why = layers::choose_shell(m->mesh, a, LayerParams{}).refused;
+  ASSERT_EQ(a.patches.size(), 4u);
+  ASSERT_TRUE(a.patches[0].needs_nonplanar() && a.patches[1].needs_nonplanar());
+  const std::string why = layers::plan_shell(m->mesh, a, {0, 1}, LayerParams{}).refused;
   EXPECT_NE(why.find("in bands"), std::string::npos) << why;
+  const layers::ShellPlan rim = layers::choose_shell(m->mesh, a, LayerParams{});
+  EXPECT_TRUE(rim.refused.empty()) << rim.refused;
+  EXPECT_EQ(rim.patches, std::vector<int>{0});
 }
 
 }  // namespace
