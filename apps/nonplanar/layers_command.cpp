@@ -141,6 +141,7 @@ int run(const LayersOptions& o) {
       const ShellSummary sh = summarize_shell(loaded->mesh, *analysis, lp);
       if (!sh.patches.empty())
         j["shell"] = {{"patches", sh.patches},
+                      {"shells", sh.shells},
                       {"layers", sh.layers},
                       {"thickness", sh.thickness},
                       {"core_layers", sh.core_layers}};
@@ -167,10 +168,10 @@ int run(const LayersOptions& o) {
     std::string list;
     for (int p : sh.patches) list += (list.empty() ? "" : ", ") + std::to_string(p);
     if (!sh.patches.empty())
-      std::printf(
-          "  shell: patch%s %s as %d curved layers of %.2f mm over %zu planar core layers\n",
-          sh.patches.size() == 1 ? "" : "es", list.c_str(), sh.layers, sh.thickness,
-          sh.core_layers);
+      std::printf("  %s: patch%s %s as %d curved layers of %.2f mm over %zu planar core layers\n",
+                  sh.shells > 1 ? (std::to_string(sh.shells) + " shells").c_str() : "shell",
+                  sh.patches.size() == 1 ? "" : "es", list.c_str(), sh.layers, sh.thickness,
+                  sh.core_layers);
     else
       std::printf("  no shell: %s\n", sh.refused.c_str());
   }

@@ -18,6 +18,9 @@ struct NormalizeParams {
   int max_rounds = 12;       ///< edge-splitting rounds at most
   /// Refused (unsupported) when a round leaves more faces than this; 0: no limit.
   std::size_t max_faces = 0;
+  /// Faces whose XY box misses [care_min, care_max] are mapped at their corners only, never
+  /// split (what is sliced of them there is not used: a shell's region lies inside), mm.
+  Vec2 care_min = Vec2::Constant(-1e300), care_max = Vec2::Constant(1e300);
 };
 
 /// What a shell's map may take: at most max(500 000, 4 × the part's) faces. A shell over

@@ -157,9 +157,10 @@ Expected<void> write_section_svg(const std::filesystem::path& file, const Triang
 /// What `slice` prints when plan_layers builds no stack but the part's whole top is curved: a
 /// shell of curved layers over a planar core (src/layers/shell_plan.hpp; README), or why not.
 struct ShellSummary {
-  std::vector<int> patches;  ///< the patches the shell follows; empty: no shell
-  int layers = 0;            ///< curved layers
-  double thickness = 0;      ///< of each, mm
+  std::vector<int> patches;  ///< the patches the shells follow; empty: no shell
+  int shells = 0;            ///< one per curved region the part stands above (choose_shells)
+  int layers = 0;            ///< curved layers (the most of any shell)
+  double thickness = 0;      ///< of each, mm (the thickest)
   std::size_t core_layers = 0;
   std::string refused;  ///< why not (empty when there is a shell)
 };

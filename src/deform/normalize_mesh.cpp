@@ -47,6 +47,17 @@ Expected<NormalizedMesh> normalize_mesh(const TriangleMesh& mesh, const LayerFie
   // round was most of this stage's time.)
   std::unordered_set<std::uint64_t> settled;
   std::vector<char> final_face(m.faces.size(), 0);
+  for (std::size_t fi = 0; fi < m.faces.size(); ++fi) {
+    Vec2 lo = Vec2::Constant(1e300), hi = Vec2::Constant(-1e300);
+    for (int v : m.faces[fi])
+      lo = lo.cwiseMin(m.vertices[v].head<2>()), hi = hi.cwiseMax(m.vertices[v].head<2>());
+    final_face[fi] = (lo.array() > params.care_max.array()).any() ||
+                     (hi.array() < params.care_min.array()).any();
+    // Its edges stay whole for its neighbours too (conforming: no crack for the slicer).
+    if (final_face[fi])
+      for (int k = 0; k < 3; ++k)
+        settled.insert(edge_key(m.faces[fi][k], m.faces[fi][(k + 1) % 3]));
+  }
   for (int round = 0; round < params.max_rounds; ++round) {
     if (ctx.cancelled()) return Error{Status::cancelled, "cancelled"};
     // Decide per edge once; the midpoint index is shared by both faces (conforming).

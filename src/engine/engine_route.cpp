@@ -66,15 +66,19 @@ Expected<EngineOutput> slice_with(const TriangleMesh& to_slice, const LayerField
   return on_file_grid(std::move(*out));
 }
 
-Expected<EngineOutput> shell_with(const TriangleMesh& mesh, const layers::ShellPlan& plan,
+Expected<EngineOutput> shell_with(const TriangleMesh& mesh,
+                                  const std::vector<layers::ShellPlan>& plans,
                                   const EngineRoute& route, const Context& ctx) {
   EngineOutput out;
   if (route.engine.engine == Engine::builtin) {
-    auto paths = shell_toolpaths(mesh, plan, route.print, ctx);
+    auto paths = shell_toolpaths(mesh, plans, route.print, ctx);
     if (!paths) return paths.error();
     out.layers = std::move(*paths);
   } else {
-    auto printed = shell_with_engine(mesh, plan, route, ctx);
+    if (plans.size() != 1)
+      return Error{Status::internal_error,
+                   "an engine prints one shell, not " + std::to_string(plans.size())};
+    auto printed = shell_with_engine(mesh, plans.front(), route, ctx);
     if (!printed) return printed.error();
     out.layers = std::move(printed->layers);
     out.gcode = std::move(printed->gcode);

@@ -38,11 +38,12 @@ struct EngineOutput {
 Expected<EngineOutput> slice_with(const TriangleMesh& to_slice, const LayerField* field,
                                   const EngineRoute& route, const Context& ctx);
 
-/// The shell plan printed by the route's engine: the built-in core and shell
+/// The shell plans printed by the route's engine: the built-in core and shells
 /// (shell_toolpaths), or the external engine's two runs stitched into one program
-/// (shell_with_engine). Errors: unsupported (the engine's core is off the plan's boundaries),
-/// those of the stages and the engine, cancelled.
-Expected<EngineOutput> shell_with(const TriangleMesh& mesh, const layers::ShellPlan& plan,
+/// (shell_with_engine: one shell only). Errors: unsupported (the engine's core is off the
+/// plan's boundaries), those of the stages and the engine, cancelled.
+Expected<EngineOutput> shell_with(const TriangleMesh& mesh,
+                                  const std::vector<layers::ShellPlan>& plans,
                                   const EngineRoute& route, const Context& ctx);
 
 /// Our header over an external engine's file: the route, `header` (what was curved) and the

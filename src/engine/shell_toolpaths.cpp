@@ -13,40 +13,53 @@
 namespace nonplanar {
 namespace {
 
-// The core: planar layers at the plan's boundaries, layer k kept where z_k <= B + a, i.e. where
-// H >= z_k − a + N·t; where the part stands above the top somewhere, cut back only inside R.
+// The core: planar layers at the plans' boundaries (one core for every shell), layer k kept
+// where z_k <= B + a, i.e. where H >= z_k − a + N·t; where the part stands above a top
+// somewhere, cut back only inside that shell's R (R[i] of plans[i]).
 Expected<std::vector<SlicedLayer>> core_layers(const TriangleMesh& mesh,
-                                               const layers::ShellPlan& plan,
-                                               const std::vector<ExPolygon>& R,
+                                               const std::vector<layers::ShellPlan>& plans,
+                                               const std::vector<std::vector<ExPolygon>>& R,
                                                const Context& ctx) {
+  const std::vector<double>& z = plans.front().core;
   std::vector<SlicedLayer> spans;
-  for (std::size_t k = 1; k < plan.core.size(); ++k) {
+  for (std::size_t k = 1; k < z.size(); ++k) {
     SlicedLayer l;
-    l.z_bottom = plan.core[k - 1], l.z_top = plan.core[k];
+    l.z_bottom = z[k - 1], l.z_top = z[k];
     l.z_slice = 0.5 * (l.z_bottom + l.z_top);
     spans.push_back(l);
   }
   auto core = slice_mesh_at(mesh, std::move(spans), ctx);
   if (!core) return core.error();
-  const auto [lo_it, hi_it] = std::minmax_element(plan.top.h.begin(), plan.top.h.end());
-  const double h_lo = *lo_it, h_hi = *hi_it;
-  const layers::ContourIndex index(plan.top);
-  const bool partial = !plan.region.empty();
+  struct Top {
+    double lo, hi;
+    layers::ContourIndex index;
+  };
+  std::vector<Top> tops;
+  for (const layers::ShellPlan& plan : plans) {
+    const auto [lo_it, hi_it] = std::minmax_element(plan.top.h.begin(), plan.top.h.end());
+    tops.push_back({*lo_it, *hi_it, layers::ContourIndex(plan.top)});
+  }
   core::parallel_for(std::size_t{0}, core->size(), [&](std::size_t k) {
     SlicedLayer& L = (*core)[k];
-    const double level = plan.core_level(L.z_top);
-    if (level <= h_lo || L.islands.empty()) return;
-    // The shell over the part cut away counts as cover for the skins below, so they are as
-    // thick (shell included) as top_solid_layers asks, not that plus the shell.
-    L.covers = L.islands;
-    if (!partial) {
-      L.islands = level > h_hi ? std::vector<ExPolygon>{}
-                               : clip::intersection_ex(L.islands, index.region_at_least(level));
-      return;
+    if (L.islands.empty()) return;
+    std::vector<ExPolygon> cut;
+    for (std::size_t i = 0; i < plans.size(); ++i) {
+      const double level = plans[i].core_level(L.z_top);
+      if (level <= tops[i].lo) continue;
+      // The shell over the part cut away counts as cover for the skins below, so they are as
+      // thick (shell included) as top_solid_layers asks, not that plus the shell.
+      if (L.covers.empty()) L.covers = L.islands;
+      if (plans[i].region.empty()) {  // the one shell, over the whole part
+        L.islands = level > tops[i].hi
+                        ? std::vector<ExPolygon>{}
+                        : clip::intersection_ex(L.islands, tops[i].index.region_at_least(level));
+        return;
+      }
+      const std::vector<ExPolygon> c =
+          level > tops[i].hi ? R[i] : clip::diff_ex(R[i], tops[i].index.region_at_least(level));
+      cut.insert(cut.end(), c.begin(), c.end());
     }
-    const std::vector<ExPolygon> cut =
-        level > h_hi ? R : clip::diff_ex(R, index.region_at_least(level));
-    L.islands = clip::diff_ex(L.islands, cut);
+    if (!cut.empty()) L.islands = clip::diff_ex(L.islands, cut);
   });
   while (!core->empty() && core->back().islands.empty()) core->pop_back();
   return core;
@@ -118,32 +131,35 @@ void split_by_slot(const ExtrusionPath& p, const layers::ShellPlan& plan,
 // Where the part stands above the top: each shell point after the core's layers up to its slot
 // level, the rest of the core after it (shell_region.hpp). Slot k holds, layer by layer in print
 // order, the pieces printed between core layers k − 1 and k (k = K: after the whole core).
+// With several shells, each one's pieces in a slot follow the one's before it (their regions
+// lie out of each other's reach).
 std::vector<LayerToolpaths> interleave(std::vector<LayerToolpaths> core,
                                        const std::vector<double>& tops,
-                                       std::vector<LayerToolpaths> shell,
-                                       const layers::ShellPlan& plan) {
+                                       const std::vector<std::vector<LayerToolpaths>>& shells,
+                                       const std::vector<layers::ShellPlan>& plans) {
   const std::size_t K = core.size();
   std::vector<std::vector<LayerToolpaths>> slots(K + 1);
-  for (std::size_t j = 0; j < shell.size(); ++j) {
-    const LayerToolpaths& L = shell[j];
-    std::vector<LayerToolpaths*> in(K + 1, nullptr);
-    for (const ExtrusionPath& p : L.paths)
-      split_by_slot(p, plan, tops, [&](int k, ExtrusionPath&& piece) {
-        auto& s = slots[static_cast<std::size_t>(k)];
-        if (!in[static_cast<std::size_t>(k)]) {
-          LayerToolpaths part;  // L's figures, none of its paths yet
-          part.height = L.height, part.nonplanar = L.nonplanar, part.max_slope = L.max_slope;
-          part.max_z = -1e300;
-          s.push_back(std::move(part));
-          in[static_cast<std::size_t>(k)] = &s.back();
-        }
-        LayerToolpaths& part = *in[static_cast<std::size_t>(k)];
-        for (const Vec3& q : piece.points) part.max_z = std::max(part.max_z, q.z());
-        part.paths.push_back(std::move(piece));
-      });
-    // The pointers into `slots` stay valid: each slot gains one part per shell layer, and
-    // the next layer's parts are pushed only after this layer is done.
-  }
+  for (std::size_t i = 0; i < shells.size(); ++i)
+    for (const LayerToolpaths& L : shells[i]) {
+      const layers::ShellPlan& plan = plans[i];
+      std::vector<LayerToolpaths*> in(K + 1, nullptr);
+      for (const ExtrusionPath& p : L.paths)
+        split_by_slot(p, plan, tops, [&](int k, ExtrusionPath&& piece) {
+          auto& s = slots[static_cast<std::size_t>(k)];
+          if (!in[static_cast<std::size_t>(k)]) {
+            LayerToolpaths part;  // L's figures, none of its paths yet
+            part.height = L.height, part.nonplanar = L.nonplanar, part.max_slope = L.max_slope;
+            part.max_z = -1e300;
+            s.push_back(std::move(part));
+            in[static_cast<std::size_t>(k)] = &s.back();
+          }
+          LayerToolpaths& part = *in[static_cast<std::size_t>(k)];
+          for (const Vec3& q : piece.points) part.max_z = std::max(part.max_z, q.z());
+          part.paths.push_back(std::move(piece));
+        });
+      // The pointers into `slots` stay valid: each slot gains one part per shell layer, and
+      // the next layer's parts are pushed only after this layer is done.
+    }
   // A shell point printed before core layer k lies at most s⁻ (about 0.1 mm) over its top: a
   // core layer under the highest shell point so far travels over it lifted.
   std::vector<LayerToolpaths> out;
@@ -162,15 +178,13 @@ std::vector<LayerToolpaths> interleave(std::vector<LayerToolpaths> core,
   return out;
 }
 
-}  // namespace
-
-Expected<std::vector<LayerToolpaths>> shell_toolpaths(const TriangleMesh& mesh,
-                                                      const layers::ShellPlan& plan,
-                                                      const PrintConfig& print,
-                                                      const Context& ctx) {
+// One shell's curved layers, bottom to top, mapped back; each point's height the thickness
+// under it. R: where it prints (empty: everywhere).
+Expected<std::vector<LayerToolpaths>> shell_layers(const TriangleMesh& mesh,
+                                                   const layers::ShellPlan& plan,
+                                                   const std::vector<ExPolygon>& R,
+                                                   const PrintConfig& print, const Context& ctx) {
   const bool partial = !plan.region.empty();
-  const std::vector<ExPolygon> R =
-      partial ? layers::region_at_least(plan.region, 0) : std::vector<ExPolygon>{};
   // The shell: normalised so its layers are the planes ζ = j·t … (j + 1)·t.
   const layers::ShellField field(plan);
   // Where the part stands above the top, H carried over it bends the map hard: to 0.005 mm the
@@ -178,19 +192,11 @@ Expected<std::vector<LayerToolpaths>> shell_toolpaths(const TriangleMesh& mesh,
   // no more than a bead's precision; its points are mapped back exactly.
   NormalizeParams np = shell_normalize_params(mesh);
   if (partial) np.tolerance = 0.02, np.max_rounds = 8;
+  if (plan.framed)  // R lies inside H's raster
+    np.care_min = plan.top.origin,
+    np.care_max = plan.top.origin + Vec2(plan.top.nx - 1, plan.top.ny - 1) * plan.top.cell;
   auto normalized = normalize_mesh(mesh, field, np, ctx);
   if (!normalized) return normalized.error();
-  // The core after the shell's map, which may refuse the shell (shell_normalize_params).
-  auto core = core_layers(mesh, plan, R, ctx);
-  if (!core) return core.error();
-  ctx.progress("core", 1.0);
-  std::vector<LayerToolpaths> core_paths;
-  if (!core->empty()) {
-    auto paths = make_toolpaths(*core, print.paths, ctx);
-    if (!paths) return paths.error();
-    core_paths = std::move(*paths);
-  }
-
   // An empty layer first stands for the bed-side neighbour make_toolpaths treats specially
   // (first-layer width and speed, the skirt): the shell is never the first layer printed.
   std::vector<SlicedLayer> shell(static_cast<std::size_t>(plan.N) + 1);
@@ -211,7 +217,7 @@ Expected<std::vector<LayerToolpaths>> shell_toolpaths(const TriangleMesh& mesh,
   planar->erase(planar->begin());
   auto mapped = map_toolpaths_back(*planar, field, {}, ctx);
   if (!mapped) return mapped.error();
-  std::vector<LayerToolpaths> shell_paths;
+  std::vector<LayerToolpaths> paths;
   for (std::size_t j = 0; j < mapped->size(); ++j) {
     LayerToolpaths& L = (*mapped)[j];
     if (L.paths.empty()) continue;
@@ -220,16 +226,46 @@ Expected<std::vector<LayerToolpaths>> shell_toolpaths(const TriangleMesh& mesh,
         p.height[k] = plan.thickness(static_cast<int>(j), p.points[k].x(), p.points[k].y());
     L.z = L.max_z;
     L.height = plan.t;
-    shell_paths.push_back(std::move(L));
+    paths.push_back(std::move(L));
   }
-  if (!partial || core_paths.empty()) {
+  return paths;
+}
+
+}  // namespace
+
+Expected<std::vector<LayerToolpaths>> shell_toolpaths(const TriangleMesh& mesh,
+                                                      const std::vector<layers::ShellPlan>& plans,
+                                                      const PrintConfig& print,
+                                                      const Context& ctx) {
+  if (plans.empty()) return Error{Status::internal_error, "shell_toolpaths: no shell"};
+  std::vector<std::vector<ExPolygon>> R;
+  std::vector<std::vector<LayerToolpaths>> shells;
+  // The shells first: their maps may refuse them (shell_normalize_params) before the core.
+  for (const layers::ShellPlan& plan : plans) {
+    R.push_back(plan.region.empty() ? std::vector<ExPolygon>{}
+                                    : layers::region_at_least(plan.region, 0));
+    auto paths = shell_layers(mesh, plan, R.back(), print, ctx);
+    if (!paths) return paths.error();
+    shells.push_back(std::move(*paths));
+  }
+  auto core = core_layers(mesh, plans, R, ctx);
+  if (!core) return core.error();
+  ctx.progress("core", 1.0);
+  std::vector<LayerToolpaths> core_paths;
+  if (!core->empty()) {
+    auto paths = make_toolpaths(*core, print.paths, ctx);
+    if (!paths) return paths.error();
+    core_paths = std::move(*paths);
+  }
+  if (plans.front().region.empty() || core_paths.empty()) {
     std::vector<LayerToolpaths> out = std::move(core_paths);
-    for (LayerToolpaths& L : shell_paths) out.push_back(std::move(L));
+    for (std::vector<LayerToolpaths>& shell : shells)
+      for (LayerToolpaths& L : shell) out.push_back(std::move(L));
     return out;
   }
   std::vector<double> tops;
   for (std::size_t k = 0; k < core_paths.size(); ++k) tops.push_back((*core)[k].z_top);
-  return interleave(std::move(core_paths), tops, std::move(shell_paths), plan);
+  return interleave(std::move(core_paths), tops, shells, plans);
 }
 
 }  // namespace nonplanar

@@ -11,14 +11,16 @@
 
 namespace nonplanar {
 
-/// Inputs: the placed mesh, an accepted plan (plan.refused empty) and the print settings.
-/// Output: the core's layers bottom to top, then the shell's lowest to highest, in print order;
-/// with a region (plan.region), each shell point is printed right after the core's last layer
-/// whose top is at most plan.slot_level there, so the shell's layers come in pieces between the
-/// core's. Every point's height is the thickness under it (the shell's lowest layer fills the
-/// core's stairs). Errors: those of slicing, normalisation and mapping; cancelled.
+/// Inputs: the placed mesh, accepted plans (refused empty; layers::choose_shells: one core,
+/// several only where the part stands above each; nothing orders the points of two shells
+/// beside each other, so the gate must check the result) and the print settings.
+/// Output: the core's layers bottom to top, then the shells' lowest to highest, in print order;
+/// with regions (plan.region), each shell point is printed right after the core's last layer
+/// whose top is at most its plan's slot_level there, so the shells' layers come in pieces
+/// between the core's. Every point's height is the thickness under it (a shell's lowest layer
+/// fills the core's stairs). Errors: those of slicing, normalisation and mapping; cancelled.
 Expected<std::vector<LayerToolpaths>> shell_toolpaths(const TriangleMesh& mesh,
-                                                      const layers::ShellPlan& plan,
+                                                      const std::vector<layers::ShellPlan>& plans,
                                                       const PrintConfig& print, const Context& ctx);
 
 }  // namespace nonplanar

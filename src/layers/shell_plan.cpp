@@ -84,7 +84,7 @@ Under under_shell(const TriangleMesh& mesh, const std::vector<char>& in_patch, c
 // R, the slack and g into the plan, and the notice of what the core prints of the patches.
 void take_region(ShellPlan& s, ShellRegion&& r) {
   s.left_out.clear();
-  if (r.left_out >= 0.5) {
+  if (r.left_out >= 0.5 && !r.why_out.empty()) {
     char buf[60];
     std::snprintf(buf, sizeof buf, "%.0f mm² of it printed planar: ", r.left_out);
     s.left_out = buf;
@@ -109,12 +109,54 @@ std::string rest_on_core(const TriangleMesh& mesh, const std::vector<char>& in_p
     if (under_shell(mesh, in_patch, s, p.max_angle_deg, thin).why.empty()) return {};
   s.N = N0;
   ShellRegion region =
-      shell_region(mesh, in_patch, first.faces, s.N * s.t + 0.5, s.top, s.below, p);
+      shell_region(mesh, in_patch, first.faces, s.N * s.t + 0.5, s.top, s.below, p, s.framed);
   if (!region.refused.empty()) return first.why;
   region.why_out.push_back(first.why);
   take_region(s, std::move(region));
   if (!under_shell(mesh, in_patch, s, p.max_angle_deg, 0.5).why.empty()) return first.why;
   return {};
+}
+
+// The patches reached from the first (the largest) through neighbours: boxes within kNear of
+// each other across and in height. Patches far off (the ornament's hanging loop, 35 mm under
+// its cap) make one top over the whole part that the part stands above nearly everywhere.
+std::vector<int> neighbourhood(const Analysis& a, const std::vector<int>& candidates) {
+  constexpr double kNear = 2.0;  // mm
+  auto close = [&](int i, int j) {
+    const Patch &P = a.patches[static_cast<std::size_t>(i)],
+                &Q = a.patches[static_cast<std::size_t>(j)];
+    return P.xy_min.x() - kNear <= Q.xy_max.x() && Q.xy_min.x() - kNear <= P.xy_max.x() &&
+           P.xy_min.y() - kNear <= Q.xy_max.y() && Q.xy_min.y() - kNear <= P.xy_max.y() &&
+           P.z_min - kNear <= Q.z_max && Q.z_min - kNear <= P.z_max;
+  };
+  std::vector<char> in(candidates.size(), 0);
+  in[0] = 1;
+  for (bool grew = true; grew;) {
+    grew = false;
+    for (std::size_t i = 0; i < candidates.size(); ++i)
+      for (std::size_t j = 0; j < candidates.size() && !in[i]; ++j)
+        if (in[j] && close(candidates[i], candidates[j])) in[i] = 1, grew = true;
+  }
+  std::vector<int> out;
+  for (std::size_t i = 0; i < candidates.size(); ++i)
+    if (in[i]) out.push_back(candidates[i]);
+  return out;
+}
+
+// The patches' XY box, mm.
+std::pair<Vec2, Vec2> patch_box(const Analysis& a, const std::vector<int>& patches) {
+  Vec2 lo = Vec2::Constant(1e300), hi = Vec2::Constant(-1e300);
+  for (int i : patches) {
+    const Patch& P = a.patches[static_cast<std::size_t>(i)];
+    lo = lo.cwiseMin(P.xy_min), hi = hi.cwiseMax(P.xy_max);
+  }
+  return {lo, hi};
+}
+
+// Are two boxes farther apart than `gap` (mm) along x or y?
+bool apart(const std::pair<Vec2, Vec2>& A, const std::pair<Vec2, Vec2>& B, double gap) {
+  const Vec2 d = (B.first - A.second).cwiseMax(A.first - B.second);
+  return d.x() > gap || d.y() > gap;
 }
 
 }  // namespace
@@ -132,7 +174,7 @@ double ShellPlan::thickness(int j, double x, double y) const {
 }
 
 ShellPlan plan_shell(const TriangleMesh& mesh, const Analysis& a, const std::vector<int>& patches,
-                     const LayerParams& p) {
+                     const LayerParams& p, double frame) {
   ShellPlan s;
   s.patches = patches;
   // The patches as one: their facets, box and height range (what faceted_top reads).
@@ -169,11 +211,20 @@ ShellPlan plan_shell(const TriangleMesh& mesh, const Analysis& a, const std::vec
   // A shell as thick as about four layers: solid under the top, and no deeper than needed
   // (features below it keep planar layers).
   s.N = std::max(3, static_cast<int>(std::ceil(0.8 / s.t - 1e-9)));
+  // H over the part's footprint (a pad as wide on every side as the patches' farthest side
+  // needs); with a frame, over the patches' surroundings only (a further shell: the bunny's
+  // tail took a raster twice the bunny's size, 0.5 s a plan).
   const Vec2 lo = box.min.head<2>(), hi = box.max.head<2>();
-  const double pad = std::max({P.xy_min.x() - lo.x(), P.xy_min.y() - lo.y(), hi.x() - P.xy_max.x(),
-                               hi.y() - P.xy_max.y(), 0.0}) +
-                     1.0;
-  s.top = faceted_top(mesh, P, 0.1, pad, std::tan(0.8 * p.max_angle_deg * kDeg) / M_SQRT2);
+  double pad = std::max({P.xy_min.x() - lo.x(), P.xy_min.y() - lo.y(), hi.x() - P.xy_max.x(),
+                         hi.y() - P.xy_max.y(), 0.0}) +
+               1.0;
+  Patch framed = P;
+  if (frame > 0) {
+    framed.xy_min = (lo - Vec2(1, 1)).cwiseMax(P.xy_min - Vec2(frame, frame));
+    framed.xy_max = (hi + Vec2(1, 1)).cwiseMin(P.xy_max + Vec2(frame, frame));
+    pad = 0, s.framed = true;
+  }
+  s.top = faceted_top(mesh, framed, 0.1, pad, std::tan(0.8 * p.max_angle_deg * kDeg) / M_SQRT2);
 
   // Where the part stands above H, the shell prints only in R (shell_region.hpp); inside R it
   // must rest on the core (rest_on_core: fewer layers over a thin wall, or what lies under it
@@ -184,7 +235,7 @@ ShellPlan plan_shell(const TriangleMesh& mesh, const Analysis& a, const std::vec
   // check's h/2 with room for the file's rounding (at the defaults t − a − 0.01 was h/2 itself,
   // and the rib over a void left a shell point 0.100 mm over a later core layer 0.28 mm away).
   s.below = std::min(s.t - s.reach - 0.01, 0.5 * p.layer_height - 0.01);
-  ShellRegion region = shell_region(mesh, in_patch, {}, 0, s.top, s.below, p);
+  ShellRegion region = shell_region(mesh, in_patch, {}, 0, s.top, s.below, p, s.framed);
   if (!region.refused.empty()) {
     s.refused = region.refused;
     return s;
@@ -220,6 +271,13 @@ ShellPlan choose_shell(const TriangleMesh& mesh, const Analysis& a, const LayerP
     return none;
   }
   ShellPlan plan = plan_shell(mesh, a, all, p);
+  if (!plan.refused.empty() && all.size() > 2) {
+    const std::vector<int> near = neighbourhood(a, all);
+    if (near.size() > 1 && near.size() < all.size()) {
+      ShellPlan some = plan_shell(mesh, a, near, p);
+      if (some.refused.empty()) return some;
+    }
+  }
   if (!plan.refused.empty() && all.size() > 1) {
     ShellPlan one = plan_shell(mesh, a, {all.front()}, p);
     if (one.refused.empty()) plan = std::move(one);
@@ -227,18 +285,66 @@ ShellPlan choose_shell(const TriangleMesh& mesh, const Analysis& a, const LayerP
   return plan;
 }
 
+std::vector<ShellPlan> choose_shells(const TriangleMesh& mesh, const Analysis& a,
+                                     const LayerParams& p, int most) {
+  std::vector<ShellPlan> shells;
+  shells.push_back(choose_shell(mesh, a, p));
+  const ShellPlan& first = shells.front();
+  if (!first.refused.empty() || first.region.empty()) return shells;
+  std::vector<int> rest;
+  for (std::size_t i = 0; i < a.patches.size(); ++i)
+    if (a.patches[i].needs_nonplanar() && std::find(first.patches.begin(), first.patches.end(),
+                                                    static_cast<int>(i)) == first.patches.end())
+      rest.push_back(static_cast<int>(i));
+  // Each plan takes a raster over the whole part (0.3 s on the bunny): twice as many tries as
+  // shells wanted, the largest groups first, none under 1 % of the curved area.
+  double curved = 0;
+  for (const Patch& q : a.patches) curved += q.needs_nonplanar() ? q.area : 0;
+  for (int tries = 0;
+       !rest.empty() && tries < 2 * (most - 1) && static_cast<int>(shells.size()) < most;) {
+    const std::vector<int> group = neighbourhood(a, rest);
+    std::vector<int> left;
+    for (int i : rest)
+      if (std::find(group.begin(), group.end(), i) == group.end()) left.push_back(i);
+    rest = std::move(left);
+    double area = 0;
+    for (int i : group) area += a.patches[static_cast<std::size_t>(i)].area;
+    if (area < 0.01 * curved) continue;
+    ++tries;
+    // Within the head's reach of a shell's patches: its points could print in any order
+    // beside that shell's (shell_toolpaths checks the printed paths themselves).
+    const auto box = patch_box(a, group);
+    if (std::any_of(shells.begin(), shells.end(), [&](const ShellPlan& s) {
+          return !apart(box, patch_box(a, s.patches), p.toolhead.reach());
+        }))
+      continue;
+    // H over the group's surroundings only, as far as the head reaches and a little more.
+    const double frame = p.toolhead.reach() + 4;
+    ShellPlan s = plan_shell(mesh, a, group, p, frame);
+    if (!s.refused.empty() && group.size() > 1) s = plan_shell(mesh, a, {group.front()}, p, frame);
+    // Every one partial (the core goes on above each), on one core.
+    if (s.refused.empty() && !s.region.empty() && s.core == shells.front().core)
+      shells.push_back(std::move(s));
+  }
+  return shells;
+}
+
 }  // namespace nonplanar::layers
 
 namespace nonplanar {
 
 ShellSummary summarize_shell(const TriangleMesh& mesh, const Analysis& a, const LayerParams& p) {
-  const layers::ShellPlan plan = layers::choose_shell(mesh, a, p);
+  const std::vector<layers::ShellPlan> plans = layers::choose_shells(mesh, a, p);
+  const layers::ShellPlan& plan = plans.front();
   ShellSummary s;
   s.refused = plan.refused;
   if (!plan.refused.empty()) return s;
-  s.patches = plan.patches;
-  s.layers = plan.N;
-  s.thickness = plan.t;
+  for (const layers::ShellPlan& q : plans) {
+    s.patches.insert(s.patches.end(), q.patches.begin(), q.patches.end());
+    s.layers = std::max(s.layers, q.N);
+    s.thickness = std::max(s.thickness, q.t);
+  }
+  s.shells = static_cast<int>(plans.size());
   s.core_layers = plan.core.size() - 1;
   return s;
 }

@@ -39,8 +39,9 @@ struct ShellPlan {
   FacetedTop region;
   /// s on H's raster, mm (shell_region.hpp); empty: the shell after the whole core.
   FacetedTop slack;
-  ShellLevels levels;  ///< g (shell_levels.hpp)
-  double below = 0;    ///< the bound of s⁻, min(t − a, h/2) − 0.01, mm
+  ShellLevels levels;   ///< g (shell_levels.hpp)
+  double below = 0;     ///< the bound of s⁻, min(t − a, h/2) − 0.01, mm
+  bool framed = false;  ///< H covers only the patches' surroundings (plan_shell's frame)
   /// What of the patches the shell leaves to the core because an overhang or another surface
   /// lies under it there, and why (empty: none).
   std::string left_out;
@@ -71,15 +72,26 @@ struct ShellPlan {
 /// an overhang lies inside the shell, or the limits leave no room for the stairs. Where some of
 /// the part stands above H, the shell prints only in R, its points interleaved with the core's
 /// layers by slot_level. The core's boundaries land on every flat patch's height that they can
-/// reach in steps within [h_min, h_c].
+/// reach in steps within [h_min, h_c]. `frame` > 0: H covers only the patches' box grown by
+/// that much (mm), and R stops short of its edge (plan.framed).
 ShellPlan plan_shell(const TriangleMesh& mesh, const Analysis& a, const std::vector<int>& patches,
-                     const LayerParams& p);
+                     const LayerParams& p, double frame = 0);
 
 /// The shell `slice` tries when no stack can be built, or when the stacks cover less than half
 /// the largest curved patch: all the patches that need curved layers as one top, or failing
-/// that the largest alone (refused, with the first reason, when neither fits; patches empty
-/// when none needs curved layers).
+/// that the group of patches near the largest (as in choose_shells), or the largest alone (refused,
+/// with the first reason, when neither fits; patches empty when none needs curved layers).
 ShellPlan choose_shell(const TriangleMesh& mesh, const Analysis& a, const LayerParams& p);
+
+/// The shells `slice` prints together: choose_shell's first; then, when the part stands above
+/// that one somewhere (its R not everywhere), one per further group of curved patches near
+/// each other (boxes within 2 mm across and in height), from the largest left: the group, or
+/// its largest patch alone. A further shell is kept when its patches' box lies farther than
+/// the head's reach from every kept shell's patches, and it plans with R not everywhere, on
+/// the same core. The bunny's back, head, ear and tail: four shells. At most `most` shells
+/// (and as many groups tried); the first may be refused (nothing else then).
+std::vector<ShellPlan> choose_shells(const TriangleMesh& mesh, const Analysis& a,
+                                     const LayerParams& p, int most = 4);
 
 /// The shell's layer field: T = N + (z − H)/t, ζ = t·T, so the normalised mesh holds the
 /// shell's layers as planes ζ = j·t … (j + 1)·t. Every column is curved.

@@ -4,20 +4,20 @@
 // Notation as in shell_plan.hpp: H the shell's top on its raster; U_j its layer j's top; z_k the
 // core's boundaries. R = {nodes with nothing of the part more than 0.02 mm above H, where H is
 // no steeper than max_angle}, shrunk by one node at its edge; outside R the core prints every layer
-// whole. d(p) the distance from p to what stands above; a(d) the head's allowance (toolhead.hpp) at
-// distance d from the nozzle; m = h/4; s(p) = L(d(p)) + m the slack, L the largest k-Lipschitz
-// function under a, k = 0.12.
+// whole. d(p) the distance from p to the nodes outside R; a(d) the head's allowance
+// (toolhead.hpp) at distance d from the nozzle; m = h/4; s(p) = L(d(p)) + m the slack, L the
+// largest k-Lipschitz function under a, k = 0.12.
 //
 // The order: a point p of shell layer j is given a time τ = clamp(g(U_j(p)), U_j(p) − s⁻(p),
 // U_j(p) + s(p)), s⁻ = min(s, t − a − 0.01, h/2 − 0.01) (so the core under p, up to
 // U_0 − (t − a), comes first, and p rises less than h/2 over the core printed after it), and
 // printed right after core layer k, the last with z_k <= τ (after the whole core when none is
-// above it; a path whose τ passes several z_k at once is cut at each). g is a non-decreasing step function of a few heights
-// (shell_levels.hpp) that the most of the patch can take, so most of the shell goes at a few
-// times, as a few pieces per layer; next to what stands above, the shell follows the wall up in
-// bands of the core's layer height, with a seam between bands (a shell banded over more than
-// half its patch is refused: each band is printed apart). Where faces given as
-// `kept_out` (an overhang under the shell) come within kept_depth under H, the nodes are left
+// above it; a path whose τ passes several z_k at once is cut at each). g is a non-decreasing step
+// function of a few heights (shell_levels.hpp) that the most of the patch can take, so most of the
+// shell goes at a few times, as a few pieces per layer; next to what stands above, the shell
+// follows the wall up in bands of the core's layer height, with a seam between bands (a shell
+// banded over more than half its patch is refused: each band is printed apart). Where faces given
+// as `kept_out` (an overhang under the shell) come within kept_depth under H, the nodes are left
 // out of R like what stands above. Why it is safe:
 // material of the core printed before p stands at most τ <= U + s, and after p starts above
 // τ >= U − s, with s <= a(d) + m (the check's collision is a rise of more than h/2 over a(d));
@@ -63,9 +63,12 @@ struct ShellRegion {
 /// faces to be left out of R where they reach higher than H − kept_depth (mm: an overhang too
 /// close under the shell's bottom; empty or size = faces), H, how far a point may be printed before
 /// its height (`below`, mm: the shell's lowest layer must come after the core under it) and the
-/// printer's layer height and head. Output: R, the slack and g, or `refused`.
+/// printer's layer height and head; `framed`: H covers only the patches' surroundings, and R
+/// stops short of its edge (the core prints everything past it). Output: R, the slack and g, or
+/// `refused`.
 ShellRegion shell_region(const TriangleMesh& mesh, const std::vector<char>& in_patch,
                          const std::vector<char>& kept_out, double kept_depth,
-                         const FacetedTop& top, double below, const LayerParams& p);
+                         const FacetedTop& top, double below, const LayerParams& p,
+                         bool framed = false);
 
 }  // namespace nonplanar::layers

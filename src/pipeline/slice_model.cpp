@@ -159,15 +159,76 @@ Expected<SliceResult> attempt(const TriangleMesh& mesh, const SliceJob& job, con
 // attempts is planar): curved shell layers over a planar core (layers/shell_plan.hpp) if the
 // gate passes them. Empty when the part is not of that kind or the shell breaks a limit (a
 // notice then says why).
+// "patch 3" or "patches 0, 2, 7": the patches of the shells, in order.
+std::string patch_names(const std::vector<int>& patches) {
+  std::string name = patches.size() > 1 ? "patches" : "patch";
+  for (std::size_t k = 0; k < patches.size(); ++k)
+    name += (k ? ", " : " ") + std::to_string(patches[k]);
+  return name;
+}
+
+// The patches of every shell.
+std::vector<int> shell_patches(const std::vector<layers::ShellPlan>& shells) {
+  std::vector<int> all;
+  for (const layers::ShellPlan& s : shells)
+    all.insert(all.end(), s.patches.begin(), s.patches.end());
+  return all;
+}
+
+// layers::choose_shells, one shell only through an external engine (its two runs take one).
+std::vector<layers::ShellPlan> shells_for(const TriangleMesh& mesh, const Analysis& a,
+                                          const SliceJob& job) {
+  return layers::choose_shells(mesh, a, job.layers, job.engine.engine == Engine::builtin ? 4 : 1);
+}
+
+// The header lines and notices of the shells printed (r's), from the planar attempt's.
+void describe_shells(const std::vector<layers::ShellPlan>& shells, const std::string& why_shell,
+                     const SliceResult& planar, SliceResult& r) {
+  const std::vector<int> patches = shell_patches(shells);
+  // The attempt's header, without its stacks' lines (the shell replaces them).
+  for (const std::string& line : planar.header)
+    if (line.rfind("patch ", 0) != 0) r.header.push_back(line);
+  for (const layers::ShellPlan& s : shells) {
+    char buf[200];
+    std::snprintf(buf, sizeof buf,
+                  "%s: a shell of %d curved layers of %.2f mm over %zu planar core layers",
+                  patch_names(s.patches).c_str(), s.N, s.t, s.core.size() - 1);
+    r.header.push_back(buf);
+  }
+  // What the planar attempt said of the shell's patches, and that no patch fits, is moot now;
+  // but a setting that would let a stack fit (a stack follows the top more closely) is kept.
+  for (const Notice& n : planar.notices) {
+    const bool about_shell = n.kind == Notice::Kind::patch_planar &&
+                             std::find(patches.begin(), patches.end(), n.patch) != patches.end();
+    if (n.kind == Notice::Kind::none_fit || (about_shell && !n.names_a_fix)) continue;
+    Notice kept = n;
+    if (about_shell)  // not planar after all: the shell prints it
+      kept.text = "patch " + std::to_string(n.patch) +
+                  " has no stack: " + n.text.substr(std::min(n.text.size(), n.text.find(": ") + 2));
+    r.notices.push_back(std::move(kept));
+  }
+  std::string left_out;
+  for (const layers::ShellPlan& s : shells)
+    if (!s.left_out.empty())
+      left_out += "; " + (shells.size() > 1 ? patch_names(s.patches) + ": " : "") + s.left_out;
+  r.notices.push_back(
+      {Notice::Kind::shell, -1,
+       patch_names(patches) +
+           (shells.size() > 1 ? ": " + std::to_string(shells.size()) + " curved shells"
+                              : ": curved shell") +
+           " over a planar core (" + why_shell + ")" + left_out});
+  for (const layers::ShellPlan& s : shells) r.shell_layers = std::max(r.shell_layers, s.N);
+  r.printed_curved = static_cast<int>(patches.size());
+}
+
 Expected<std::optional<SliceResult>> try_shell(const TriangleMesh& mesh, const SliceJob& job,
-                                               const layers::ShellPlan& plan,
+                                               const std::vector<layers::ShellPlan>& shells,
                                                const std::string& why_shell, SliceResult& planar,
                                                const Context& ctx) {
-  if (plan.patches.empty()) return std::optional<SliceResult>{};
-  std::string name = "patch";
-  if (plan.patches.size() > 1) name += "es";
-  for (std::size_t k = 0; k < plan.patches.size(); ++k)
-    name += (k ? ", " : " ") + std::to_string(plan.patches[k]);
+  const std::vector<int> patches = shell_patches(shells);
+  if (patches.empty()) return std::optional<SliceResult>{};
+  const layers::ShellPlan& plan = shells.front();
+  const std::string name = patch_names(patches);
   auto refused = [&](const std::string& why) {
     return Notice{Notice::Kind::shell_refused, -1, name + " not printed as a shell: " + why};
   };
@@ -177,42 +238,18 @@ Expected<std::optional<SliceResult>> try_shell(const TriangleMesh& mesh, const S
   }
   SliceResult r;
   const EngineRoute route{job.engine, job.print, job.layers, job.map_back};
-  auto printed = shell_with(mesh, plan, route, ctx);
+  auto printed = shell_with(mesh, shells, route, ctx);
   if (!printed && printed.error().status == Status::unsupported) {
     planar.notices.push_back(refused(printed.error().message));
+    if (shells.size() > 1) return try_shell(mesh, job, {shells.front()}, why_shell, planar, ctx);
     return std::optional<SliceResult>{};
   }
   if (!printed) return printed.error();
   r.layers = std::move(printed->layers);
   r.gcode = std::move(printed->gcode);
-  // The attempt's header, without its stacks' lines (the shell replaces them).
-  for (const std::string& line : planar.header)
-    if (line.rfind("patch ", 0) != 0) r.header.push_back(line);
-  char buf[200];
-  std::snprintf(buf, sizeof buf,
-                "%s: a shell of %d curved layers of %.2f mm over %zu planar core layers",
-                name.c_str(), plan.N, plan.t, plan.core.size() - 1);
-  r.header.push_back(buf);
-  // What the planar attempt said of the shell's patches, and that no patch fits, is moot now;
-  // but a setting that would let a stack fit (a stack follows the top more closely) is kept.
-  for (const Notice& n : planar.notices) {
-    const bool about_shell =
-        n.kind == Notice::Kind::patch_planar &&
-        std::find(plan.patches.begin(), plan.patches.end(), n.patch) != plan.patches.end();
-    if (n.kind == Notice::Kind::none_fit || (about_shell && !n.names_a_fix)) continue;
-    Notice kept = n;
-    if (about_shell)  // not planar after all: the shell prints it
-      kept.text = "patch " + std::to_string(n.patch) +
-                  " has no stack: " + n.text.substr(std::min(n.text.size(), n.text.find(": ") + 2));
-    r.notices.push_back(std::move(kept));
-  }
-  r.notices.push_back({Notice::Kind::shell, -1,
-                       name + ": curved shell over a planar core (" + why_shell + ")" +
-                           (plan.left_out.empty() ? "" : "; " + plan.left_out)});
+  describe_shells(shells, why_shell, planar, r);
   if (!r.gcode.empty()) r.gcode = engine_header(route, r.header, plan.core.at(1)) + r.gcode;
   r.nonplanar = true;
-  r.shell_layers = plan.N;
-  r.printed_curved = static_cast<int>(plan.patches.size());
   std::string breach;
   auto ok = gate(
       r, job, nullptr,
@@ -226,6 +263,8 @@ Expected<std::optional<SliceResult>> try_shell(const TriangleMesh& mesh, const S
   if (!ok) return ok.error();
   if (!*ok) {
     planar.notices.push_back(refused(breach));
+    // Nothing orders two shells' points beside each other: the first shell alone, then.
+    if (shells.size() > 1) return try_shell(mesh, job, {shells.front()}, why_shell, planar, ctx);
     return std::optional<SliceResult>{};
   }
   return std::optional<SliceResult>(std::move(r));
@@ -243,14 +282,14 @@ Expected<std::optional<SliceResult>> shell_over_stacks(const TriangleMesh& mesh,
                                                        const SliceJob& job, const Analysis& a,
                                                        SliceResult& stacked, const Context& ctx) {
   ctx.progress("shell", 0);
-  const layers::ShellPlan plan = layers::choose_shell(mesh, a, job.layers);
-  if (!plan.refused.empty() ||
-      !(area_of(a, plan.patches) > 2 * area_of(a, stacked_patches(stacked.plan))))
+  const std::vector<layers::ShellPlan> shells = shells_for(mesh, a, job);
+  const double area = area_of(a, shell_patches(shells));
+  if (!shells.front().refused.empty() || !(area > 2 * area_of(a, stacked_patches(stacked.plan))))
     return std::optional<SliceResult>{};
   char why[160];
   std::snprintf(why, sizeof why, "its %.0f mm² print curved, where stacks would cover %.0f mm²",
-                area_of(a, plan.patches), area_of(a, stacked_patches(stacked.plan)));
-  return try_shell(mesh, job, plan, why, stacked, ctx);
+                area, area_of(a, stacked_patches(stacked.plan)));
+  return try_shell(mesh, job, shells, why, stacked, ctx);
 }
 
 }  // namespace
@@ -331,8 +370,8 @@ Expected<SliceResult> slice_rounds(const TriangleMesh& mesh, const SliceJob& job
       ctx.progress("shell", 0);
       // All the patches that need curved layers, taken as one top (the CurviSlicer airfoil's
       // top is two, split at a crease); failing that, the largest alone.
-      const layers::ShellPlan plan = layers::choose_shell(mesh, pre.analysis, job.layers);
-      auto shell = try_shell(mesh, job, plan, "no stack over a plane fits it", *r, ctx);
+      const std::vector<layers::ShellPlan> plans = shells_for(mesh, pre.analysis, job);
+      auto shell = try_shell(mesh, job, plans, "no stack over a plane fits it", *r, ctx);
       if (!shell) return shell.error();
       if (*shell) return done(std::move(**shell));
       const std::vector<Notice> notices = std::move(r->notices);
