@@ -105,11 +105,10 @@ Expected<bool> gate(SliceResult& r, const SliceJob& job, const layers::BandedFie
       return std::any_of(zones.query.begin(), zones.query.end(),
                          [&](const BoundingBox& b) { return b.contains(p); });
     };
-  if (!banded)
-    looked_at = [&](const Vec3& p) { return p.z() >= late.lo - 1 && p.z() <= late.hi + 1; };
+  if (!banded) looked_at = [&](const Vec3& p) { return late.looked_at(p); };
   auto keep = [&](const GcodeMove& m) {
     return banded ? zones.may_matter(m, m.layer)
-                  : m.layer <= late.last_layer && std::max(m.from.z(), m.to.z()) >= late.lo - 1;
+                  : late.may_matter(std::max(m.from.z(), m.to.z()), m.layer);
   };
   auto figures = find_collisions(read_print_moves(r.gcode, keep), job.check, looked_at, ctx);
   beside.wait();

@@ -54,17 +54,43 @@ GateZones gate_zones(const layers::BandedField& field, double R) {
 OutOfOrder out_of_order(const std::vector<LayerToolpaths>& layers) {
   // Between two path points z is linear, so a point between them is below the highest point
   // before it only if one of them is: their heights bound every sample's.
-  OutOfOrder o;
+  constexpr double kApart = 2.0;  // mm
+  std::vector<OutOfOrder::Span> spans;
   double highest = -1e300;
   for (std::size_t i = 0; i < layers.size(); ++i)
     for (const ExtrusionPath& p : layers[i].paths)
       for (const Vec3& v : p.points) {
-        if (v.z() < highest)
-          o.lo = std::min(o.lo, v.z()), o.hi = std::max(o.hi, v.z()),
-          o.last_layer = static_cast<int>(i);
+        if (v.z() < highest) {
+          auto it = std::find_if(spans.begin(), spans.end(), [&](const OutOfOrder::Span& s) {
+            return v.z() >= s.lo - kApart && v.z() <= s.hi + kApart;
+          });
+          if (it == spans.end()) it = spans.insert(spans.end(), OutOfOrder::Span{});
+          it->lo = std::min(it->lo, v.z()), it->hi = std::max(it->hi, v.z());
+          it->last_layer = static_cast<int>(i);
+        }
         highest = std::max(highest, v.z());
       }
+  // Spans that grew into each other: one.
+  std::sort(spans.begin(), spans.end(),
+            [](const OutOfOrder::Span& a, const OutOfOrder::Span& b) { return a.lo < b.lo; });
+  OutOfOrder o;
+  for (const OutOfOrder::Span& s : spans)
+    if (!o.spans.empty() && s.lo <= o.spans.back().hi + kApart)
+      o.spans.back().hi = std::max(o.spans.back().hi, s.hi),
+      o.spans.back().last_layer = std::max(o.spans.back().last_layer, s.last_layer);
+    else
+      o.spans.push_back(s);
   return o;
+}
+
+bool OutOfOrder::looked_at(const Vec3& p) const {
+  return std::any_of(spans.begin(), spans.end(),
+                     [&](const Span& s) { return p.z() >= s.lo - 1 && p.z() <= s.hi + 1; });
+}
+
+bool OutOfOrder::may_matter(double z, int layer) const {
+  return std::any_of(spans.begin(), spans.end(),
+                     [&](const Span& s) { return layer <= s.last_layer && z >= s.lo - 1; });
 }
 
 }  // namespace nonplanar

@@ -34,16 +34,24 @@ struct GateZones {
 /// The zones of every band of `field`; R in mm.
 GateZones gate_zones(const layers::BandedField& field, double R);
 
-/// Heights where a point may meet earlier material, for a program without bands (a shell
-/// over a planar core): material printed before a point and no higher than it cannot reach
-/// into the head, so only the points lower than the highest point printed before them count
-/// (the same layer's included, which only adds points). [lo, hi] spans those points' heights
-/// in `layers` (print order); lo > hi: there are none. The material such a point can meet lies
-/// above lo, and was printed no later than last_layer, the last layer with such a point (-1:
-/// none). In mm.
+/// Heights where a point may meet earlier material, for a program without bands (shells over
+/// a planar core): material printed before a point and no higher than it cannot reach into the
+/// head, so only the points lower than the highest point printed before them count (the same
+/// layer's included, which only adds points). Each span [lo, hi] holds such points' heights,
+/// spans 2 mm or more apart kept apart (several shells at different heights: the bunny's tail,
+/// back, head and ear); the material such a point can meet lies above its span's lo, and was
+/// printed no later than the span's last_layer, the last layer with one of its points. Spans
+/// in order of lo; none: nothing is out of order. In mm.
 struct OutOfOrder {
-  double lo = 1e300, hi = -1e300;
-  int last_layer = -1;
+  struct Span {
+    double lo = 1e300, hi = -1e300;
+    int last_layer = -1;
+  };
+  std::vector<Span> spans;
+  /// Is p (printed) within a millimetre of a span?
+  bool looked_at(const Vec3& p) const;
+  /// May a move of `layer` reaching up to z be above a point of a span, printed before it?
+  bool may_matter(double z, int layer) const;
 };
 OutOfOrder out_of_order(const std::vector<LayerToolpaths>& layers);
 

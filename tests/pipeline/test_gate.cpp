@@ -51,14 +51,39 @@ TEST(GateZones, OutOfOrderSpansThePointsPrintedBelowEarlierOnes) {
   for (int k = 0; k < 5; ++k)
     planar.push_back(layer(0.2 * (k + 1), {path({{0, 0, 0.2 * (k + 1)}, {10, 0, 0.2 * (k + 1)}})}));
   const OutOfOrder none = out_of_order(planar);
-  EXPECT_GT(none.lo, none.hi);
-  EXPECT_EQ(none.last_layer, -1);
+  EXPECT_TRUE(none.spans.empty());
   // The core layer at 0.6 mm comes after the ramp's 4.6 mm: it alone is out of order, and the
   // layers above 4.6 mm are not.
   const OutOfOrder late = out_of_order(ramp_then_core(115));
-  EXPECT_DOUBLE_EQ(late.lo, 0.6);
-  EXPECT_DOUBLE_EQ(late.hi, 0.6);
-  EXPECT_EQ(late.last_layer, 3);
+  ASSERT_EQ(late.spans.size(), 1u);
+  EXPECT_DOUBLE_EQ(late.spans[0].lo, 0.6);
+  EXPECT_DOUBLE_EQ(late.spans[0].hi, 0.6);
+  EXPECT_EQ(late.spans[0].last_layer, 3);
+  EXPECT_TRUE(late.looked_at(Vec3(0, 0, 1.5)));
+  EXPECT_FALSE(late.looked_at(Vec3(0, 0, 1.7)));
+  EXPECT_TRUE(late.may_matter(4.6, 1));
+  EXPECT_FALSE(late.may_matter(4.6, 4));   // printed after the last point out of order
+  EXPECT_FALSE(late.may_matter(-0.5, 1));  // under every such point
+}
+
+// Two shells far apart in height, each printed between the core's layers: two spans, and
+// what is printed between them matters to neither.
+TEST(GateZones, OutOfOrderKeepsShellsAtDifferentHeightsApart) {
+  std::vector<LayerToolpaths> L;
+  auto flat = [&](double z) { L.push_back(layer(z, {path({{0, 0, z}, {10, 0, z}})})); };
+  for (int k = 1; k <= 10; ++k) flat(0.2 * k);    // layers 0-9, up to 2 mm
+  flat(2.3), flat(2.1);                           // 10, 11: 2.1 after 2.3
+  for (int k = 11; k <= 100; ++k) flat(0.2 * k);  // 12-101, up to 20 mm
+  flat(20.3), flat(20.15);                        // 102, 103: 20.15 after 20.3
+  const OutOfOrder o = out_of_order(L);
+  ASSERT_EQ(o.spans.size(), 2u);
+  EXPECT_DOUBLE_EQ(o.spans[0].lo, 2.1);
+  EXPECT_EQ(o.spans[0].last_layer, 12);  // the core's 2.2 mm after the 2.3 mm piece
+  EXPECT_DOUBLE_EQ(o.spans[1].lo, 20.15);
+  EXPECT_EQ(o.spans[1].last_layer, 103);
+  EXPECT_FALSE(o.looked_at(Vec3(0, 0, 10)));
+  EXPECT_FALSE(o.may_matter(10, 50));  // above the first span, but printed after it
+  EXPECT_TRUE(o.may_matter(19.5, 101));
 }
 
 // The gate finds the core layer that runs into the ramp printed before it, though it searches
