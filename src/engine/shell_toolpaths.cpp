@@ -131,8 +131,8 @@ void split_by_slot(const ExtrusionPath& p, const layers::ShellPlan& plan,
 // Where the part stands above the top: each shell point after the core's layers up to its slot
 // level, the rest of the core after it (shell_region.hpp). Slot k holds, layer by layer in print
 // order, the pieces printed between core layers k − 1 and k (k = K: after the whole core).
-// With several shells, each one's pieces in a slot follow the one's before it (their regions
-// lie out of each other's reach).
+// With several shells, each one's pieces in a slot follow the one's before it (their patches
+// lie beyond the head's reach of each other's; the gate checks what they print).
 std::vector<LayerToolpaths> interleave(std::vector<LayerToolpaths> core,
                                        const std::vector<double>& tops,
                                        const std::vector<std::vector<LayerToolpaths>>& shells,

@@ -155,10 +155,6 @@ Expected<SliceResult> attempt(const TriangleMesh& mesh, const SliceJob& job, con
   return r;
 }
 
-// A part whose whole top is one patch no stack over a plane could follow (the result of the
-// attempts is planar): curved shell layers over a planar core (layers/shell_plan.hpp) if the
-// gate passes them. Empty when the part is not of that kind or the shell breaks a limit (a
-// notice then says why).
 // "patch 3" or "patches 0, 2, 7": the patches of the shells, in order.
 std::string patch_names(const std::vector<int>& patches) {
   std::string name = patches.size() > 1 ? "patches" : "patch";
@@ -221,6 +217,9 @@ void describe_shells(const std::vector<layers::ShellPlan>& shells, const std::st
   r.printed_curved = static_cast<int>(patches.size());
 }
 
+// Curved shells over a planar core (layers/shell_plan.hpp) for a part no stack serves, or
+// serves little, if the gate passes them. Empty when a shell is refused or breaks a limit (a
+// notice then says why).
 Expected<std::optional<SliceResult>> try_shell(const TriangleMesh& mesh, const SliceJob& job,
                                                const std::vector<layers::ShellPlan>& shells,
                                                const std::string& why_shell, SliceResult& planar,
@@ -241,7 +240,6 @@ Expected<std::optional<SliceResult>> try_shell(const TriangleMesh& mesh, const S
   auto printed = shell_with(mesh, shells, route, ctx);
   if (!printed && printed.error().status == Status::unsupported) {
     planar.notices.push_back(refused(printed.error().message));
-    if (shells.size() > 1) return try_shell(mesh, job, {shells.front()}, why_shell, planar, ctx);
     return std::optional<SliceResult>{};
   }
   if (!printed) return printed.error();
@@ -263,33 +261,50 @@ Expected<std::optional<SliceResult>> try_shell(const TriangleMesh& mesh, const S
   if (!ok) return ok.error();
   if (!*ok) {
     planar.notices.push_back(refused(breach));
-    // Nothing orders two shells' points beside each other: the first shell alone, then.
-    if (shells.size() > 1) return try_shell(mesh, job, {shells.front()}, why_shell, planar, ctx);
     return std::optional<SliceResult>{};
   }
   return std::optional<SliceResult>(std::move(r));
 }
 
+// try_shell over every shell, and when the set is refused, the first alone (nothing orders two
+// shells' points beside each other), if it too covers more than `min_area` mm². why(area): the
+// notice's reason for the shells printed, given their curved area.
+Expected<std::optional<SliceResult>> try_shells(const TriangleMesh& mesh, const SliceJob& job,
+                                                const Analysis& a,
+                                                const std::vector<layers::ShellPlan>& shells,
+                                                const std::function<std::string(double)>& why,
+                                                double min_area, SliceResult& planar,
+                                                const Context& ctx) {
+  auto printed = try_shell(mesh, job, shells, why(area_of(a, shell_patches(shells))), planar, ctx);
+  if (!printed || *printed || shells.size() == 1) return printed;
+  const double first = area_of(a, shells.front().patches);
+  if (!(first > min_area)) return printed;
+  return try_shell(mesh, job, {shells.front()}, why(first), planar, ctx);
+}
+
 // A part whose stacks follow only a little of its curved top (the CurviSlicer car: 172 mm² of
 // roof, while its 486 mm² body, hollow under the hood, has none): a shell instead, if that
 // plans and passes the gate: over all its curved patches (the car: 1065 mm², 84 % of its
-// curved top within 0.03 mm, where the body alone gave 57 %), else over the largest alone
-// (the bunny and the Voron ornament refuse the whole). Stacks follow the top more closely and
-// cost no bands, so the shell must cover more than twice their area (shell_may_cover_more
-// asks it of all curved patches first; `stacked` is an attempt it deferred, its stacks
-// planned but not sliced; none returned: the caller slices them).
+// curved top within 0.03 mm, where the body alone gave 57 %), else over the group round the
+// largest or the largest alone, and one per further curved region (layers::choose_shells). Stacks
+// follow the top more closely and cost no bands, so the shell must cover more than twice their area
+// (shell_may_cover_more asks it of all curved patches first; `stacked` is an attempt it deferred,
+// its stacks planned but not sliced; none returned: the caller slices them).
 Expected<std::optional<SliceResult>> shell_over_stacks(const TriangleMesh& mesh,
                                                        const SliceJob& job, const Analysis& a,
                                                        SliceResult& stacked, const Context& ctx) {
   ctx.progress("shell", 0);
   const std::vector<layers::ShellPlan> shells = shells_for(mesh, a, job);
-  const double area = area_of(a, shell_patches(shells));
-  if (!shells.front().refused.empty() || !(area > 2 * area_of(a, stacked_patches(stacked.plan))))
+  const double stacks = area_of(a, stacked_patches(stacked.plan));
+  if (!shells.front().refused.empty() || !(area_of(a, shell_patches(shells)) > 2 * stacks))
     return std::optional<SliceResult>{};
-  char why[160];
-  std::snprintf(why, sizeof why, "its %.0f mm² print curved, where stacks would cover %.0f mm²",
-                area, area_of(a, stacked_patches(stacked.plan)));
-  return try_shell(mesh, job, shells, why, stacked, ctx);
+  auto why = [&](double area) {
+    char buf[160];
+    std::snprintf(buf, sizeof buf, "its %.0f mm² print curved, where stacks would cover %.0f mm²",
+                  area, stacks);
+    return std::string(buf);
+  };
+  return try_shells(mesh, job, a, shells, why, 2 * stacks, stacked, ctx);
 }
 
 }  // namespace
@@ -369,9 +384,12 @@ Expected<SliceResult> slice_rounds(const TriangleMesh& mesh, const SliceJob& job
       r->notices.insert(r->notices.begin(), dropped.begin(), dropped.end());
       ctx.progress("shell", 0);
       // All the patches that need curved layers, taken as one top (the CurviSlicer airfoil's
-      // top is two, split at a crease); failing that, the largest alone.
+      // top is two, split at a crease); failing that, the group round the largest, or the
+      // largest alone; and a shell per further curved region the part stands above.
       const std::vector<layers::ShellPlan> plans = shells_for(mesh, pre.analysis, job);
-      auto shell = try_shell(mesh, job, plans, "no stack over a plane fits it", *r, ctx);
+      auto shell = try_shells(
+          mesh, job, pre.analysis, plans,
+          [](double) { return std::string("no stack over a plane fits it"); }, 0, *r, ctx);
       if (!shell) return shell.error();
       if (*shell) return done(std::move(**shell));
       const std::vector<Notice> notices = std::move(r->notices);
