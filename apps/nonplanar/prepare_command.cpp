@@ -116,6 +116,9 @@ int run(const PrepareOptions& o) {
   lp.bed_center = cfg->bed_center();
   auto loaded = load_mesh(o.mesh.model, lp, ctx);
   if (!loaded) return finish_progress(), report_error(loaded.error());
+  if (loaded->objects.several() && !o.mesh.quiet)
+    std::fprintf(stderr, "notice: %s: its %zu objects are prepared as one object\n",
+                 o.mesh.model.c_str(), loaded->objects.items.size());
   job.header.push_back("model: " + o.mesh.model);
   auto part = prepare_part(loaded->mesh, job, ctx);
   if (!part) {

@@ -124,6 +124,17 @@ int run(const SliceOptions& o) {
   job.planar_only = o.planar;
   job.engine = engine;
   job.header.push_back("model: " + o.mesh.model);
+  if (loaded->objects.several()) {
+    // A 3MF's build items, where it placed them: each layer prints them one by one, each
+    // with its own label. Another slicer gets the normalised part as one object.
+    if (job.engine.engine == Engine::builtin) {
+      cfg.gcode.objects = job.print.gcode.objects = loaded->objects.items;
+      job.objects = object_outlines(loaded->mesh, loaded->objects);
+    } else if (!o.mesh.quiet) {
+      std::fprintf(stderr, "notice: %s: its %zu objects go to %s as one object\n",
+                   o.mesh.model.c_str(), loaded->objects.items.size(), o.engine.c_str());
+    }
+  }
   auto result = slice_model(loaded->mesh, job, ctx);
   if (!result) {
     Error e = result.error();

@@ -69,6 +69,9 @@ struct GcodeParams {
   std::string before_layer_gcode, layer_gcode, start_filament_gcode, end_filament_gcode;
   /// The object's name in its labels (gcode_label_objects): the model's file name.
   std::string object_name = "part";
+  /// A plate's objects, for their labels (ExtrusionPath::object indexes them); with fewer
+  /// than two, the one object is object_name.
+  std::vector<PlateObject> objects;
 };
 
 /// Settings PrusaSlicer states relative to others, as written: "150%" (widths: of the layer

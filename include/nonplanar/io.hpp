@@ -36,6 +36,7 @@ struct LoadedMesh {
   std::size_t input_triangles = 0;
   double weld_tolerance = 0.0;        ///< absolute, mm
   std::vector<std::string> warnings;  ///< one line each, without the file name
+  PlateObjects objects;               ///< a 3MF's several objects and their faces
 };
 
 /// Read, weld, orient and place a mesh. The format is chosen by extension (.stl .obj .off

@@ -5,6 +5,7 @@
 #include <Eigen/Geometry>
 #include <array>
 #include <cstddef>
+#include <string>
 #include <vector>
 
 namespace nonplanar {
@@ -18,6 +19,20 @@ using Vec3 = Eigen::Vector3d;
 struct TriangleMesh {
   std::vector<Vec3> vertices;
   std::vector<std::array<int, 3>> faces;
+};
+
+/// The objects a file places on the plate, as PrusaSlicer keeps them apart: a 3MF's build
+/// items (one per object instance). STL, OBJ and OFF hold one object, and so does a 3MF of one
+/// item: then both vectors are empty.
+struct PlateObject {
+  std::string name;
+  int id = 0;    ///< PrusaSlicer's object number: the instances of one object share it
+  int copy = 0;  ///< which instance of that object (0 first)
+};
+struct PlateObjects {
+  std::vector<PlateObject> items;  ///< one per object instance, in the file's order
+  std::vector<int> face;           ///< per face of the mesh: its item's index
+  bool several() const { return items.size() > 1; }
 };
 
 /// Axis-aligned bounding box; empty when min > max.

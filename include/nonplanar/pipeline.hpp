@@ -11,6 +11,7 @@
 #include "nonplanar/engine.hpp"
 #include "nonplanar/gcode.hpp"
 #include "nonplanar/layers.hpp"
+#include "nonplanar/program.hpp"
 
 namespace nonplanar {
 
@@ -49,6 +50,10 @@ struct SliceJob {
   EngineParams engine;
   /// More lines for the G-code's header, after the pipeline's own (the CLI names the model).
   std::vector<std::string> header;
+  /// A plate of several objects (object_outlines of the mesh given to slice_model): the
+  /// built-in engine prints each layer object by object, labelled with print.gcode's
+  /// objects. Empty: one object.
+  std::vector<ObjectOutline> objects;
 };
 
 /// A job whose layer and check settings agree with the print configuration: heights, the

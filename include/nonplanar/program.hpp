@@ -12,7 +12,9 @@
 #include <vector>
 
 #include "nonplanar/mesh.hpp"
+#include "nonplanar/polygon.hpp"
 #include "nonplanar/status.hpp"
+#include "nonplanar/toolpaths.hpp"
 
 namespace nonplanar {
 
@@ -144,5 +146,35 @@ std::vector<PrintMove> read_print_moves(
 /// must outlive them). Refused (parse_error naming the
 /// line): any problem but home and probe (arcs, inches, unknown G-codes, junk).
 Expected<std::vector<PrintMove>> read_gcode_moves(std::string_view text);
+
+// A plate of several objects (a 3MF's build items): whose each path is, and each layer printed
+// object by object, as PrusaSlicer prints a plate, so each can be labelled and cancelled.
+
+/// An object seen from above: its box, and where another object's box overlaps it, its
+/// shadow on a raster over the box (a cell is set where some face's XY shadow, grown by half a
+/// cell's diagonal, touches it). mm.
+struct ObjectOutline {
+  BoundingBox box;
+  Vec2 origin{0, 0};  ///< the raster's corner (cell (0, 0) spans origin … origin + cell)
+  double cell = 0;
+  int nx = 0, ny = 0;
+  std::vector<char> shadow;  ///< nx·ny cells, (i, j) at i·ny + j; empty: no raster
+  /// Whether (x, y) is in the shadow (with no raster: in the box).
+  bool covers(const Vec2& p) const;
+};
+
+/// One outline per object of `objects` (objects.face: an index per face of `mesh`); none when
+/// the plate holds one object. Rasters of 0.2 mm cells (coarser past 4 million a raster).
+std::vector<ObjectOutline> object_outlines(const TriangleMesh& mesh, const PlateObjects& objects);
+
+/// The object a point prints: the one whose footprint holds it in XY, among those whose box
+/// it is in (or nearest to, for a point between footprints); 0 with one outline or none.
+int object_at(const std::vector<ObjectOutline>& outlines, const Vec3& p);
+
+/// Sets each path's `object` (by the point halfway along it; the skirt's stay 0) and orders
+/// each layer's paths by object, stably and with the skirt first: a layer prints one object
+/// after another, each in its own order. Nothing changes with fewer than two outlines.
+void group_by_object(std::vector<LayerToolpaths>& layers,
+                     const std::vector<ObjectOutline>& outlines);
 
 }  // namespace nonplanar

@@ -31,6 +31,7 @@ struct ExtrusionPath {
   double speed = 40;  ///< mm/s
   std::vector<Vec3> points;
   std::vector<double> height;
+  int object = 0;  ///< the plate object it prints (PlateObjects' index; 0 for one object)
 };
 
 struct LayerToolpaths {

@@ -445,10 +445,13 @@ Expected<std::string> make_gcode(const std::vector<LayerToolpaths>& layers, cons
     ExtrusionRole role = ExtrusionRole::skirt;
     double width = -1;
     bool first = true;
-    bool labelled = false;  // inside this layer's object label
+    int labelled = -1;  // the object whose label this layer is inside (-1: none)
     for (const ExtrusionPath& p : L.paths) {
       if (p.points.size() < 2) continue;
-      if (!labelled && p.role != ExtrusionRole::skirt) em.raw(labels.start()), labelled = true;
+      if (labelled != p.object && p.role != ExtrusionRole::skirt) {
+        if (labelled >= 0) em.raw(labels.stop(labelled));
+        em.raw(labels.start(p.object)), labelled = p.object;
+      }
       em.what = p.role == ExtrusionRole::skirt ? "the skirt" : "the print";
       em.travel(p.points.front(), c.paths.travel_speed, L.nonplanar, L.max_z, L.max_slope);
       if (first || p.role != role) em.line(";TYPE:%s", role_name(p.role));
@@ -465,7 +468,7 @@ Expected<std::string> make_gcode(const std::vector<LayerToolpaths>& layers, cons
         em.extrude(p.points[k], de, p.speed);
       }
     }
-    if (labelled) em.raw(labels.stop());
+    if (labelled >= 0) em.raw(labels.stop(labelled));
     em.retract();
     ctx.progress("gcode", static_cast<double>(i + 1) / static_cast<double>(layers.size()));
   }

@@ -1,5 +1,5 @@
 // Object labels (PrusaSlicer's gcode_label_objects): the lines that let a printer or its host
-// cancel one object mid-print. The built-in engine prints one object, the whole part.
+// cancel one object mid-print: the part, or each object of a plate (ExtrusionPath::object).
 #pragma once
 
 #include <string>
@@ -14,18 +14,20 @@ struct ObjectLabels {
   bool comments = false;  ///< "; printing object NAME id:0 copy 0" (OctoPrint's)
   bool firmware = false;  ///< M486 (Marlin, RepRapFirmware) or EXCLUDE_OBJECT_* (Klipper)
   bool klipper = false;
-  std::string name;  ///< as the comments carry it; `id` is the firmware's form of it
+  /// Object k's name, id and copy, as the comments carry them ("NAME id:ID copy COPY"; Klipper's
+  /// NAME is a one-word form of the three, the firmware's M486 number is k).
+  std::vector<PlateObject> objects;
 
-  /// Before the print: Klipper's EXCLUDE_OBJECT_DEFINE with the footprint of the layers'
-  /// paths but the skirt (their XY box, mm), or M486 T1.
+  /// Before the print: for each object, Klipper's EXCLUDE_OBJECT_DEFINE with the footprint of
+  /// its paths (their XY box, mm; the skirt is no object's); or M486 T<objects>.
   std::string define(const std::vector<LayerToolpaths>& layers) const;
-  std::string start() const;  ///< before the object's paths of a layer
-  std::string stop() const;   ///< after them
+  std::string start(int object) const;  ///< before the object's paths in a layer
+  std::string stop(int object) const;   ///< after them
 };
 
 /// From gcode_label_objects as each PrusaSlicer writes it: firmware (2.6: both kinds), 1
-/// (2.5) or octoprint (comments only), 0 or disabled or absent (none); the object named
-/// GcodeParams::object_name.
+/// (2.5) or octoprint (comments only), 0 or disabled or absent (none); the objects of
+/// GcodeParams::objects, or the one object GcodeParams::object_name.
 ObjectLabels object_labels(const PrintConfig& c);
 
 }  // namespace nonplanar::gcode

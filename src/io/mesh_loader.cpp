@@ -93,7 +93,8 @@ Expected<LoadedMesh> load_mesh(const std::filesystem::path& file, const LoadPara
     raw = io::parse_off(data);
   } else {
     out.format = MeshFormat::threemf;
-    raw = io::parse_3mf(data, params.max_triangles);
+    raw = io::parse_3mf(data, params.max_triangles, &out.objects);
+    if (!out.objects.several()) out.objects = {};
   }
   *bytes = io::FileBytes();  // unmap
   if (!raw) return with_file(file, raw.error());
@@ -111,9 +112,10 @@ Expected<LoadedMesh> load_mesh(const std::filesystem::path& file, const LoadPara
 
   out.input_triangles = raw->faces.size();
   out.weld_tolerance = io::weld_tolerance(*raw, params.weld_tolerance_rel);
-  out.mesh = io::weld(std::move(*raw), out.weld_tolerance, &out.defects.collapsed_faces);
+  out.mesh = io::weld(std::move(*raw), out.weld_tolerance, &out.defects.collapsed_faces,
+                      &out.objects.face);
   raw = Error{};
-  out.defects.duplicate_faces = io::remove_duplicate_faces(out.mesh);
+  out.defects.duplicate_faces = io::remove_duplicate_faces(out.mesh, &out.objects.face);
   if (out.mesh.faces.empty())
     return with_file(file, {Status::invalid_mesh, "every triangle is degenerate"});
   out.weld_tolerance *= params.scale;

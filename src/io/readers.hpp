@@ -22,6 +22,10 @@ Expected<TriangleMesh> parse_off(std::string_view data);
 /// 3MF through lib3mf: every build item, components resolved, transforms applied, in mm
 /// whatever the model's `unit` (micron … meter). Triangles are counted before any is built:
 /// more than `max_triangles` is an invalid_mesh error. A non-finite transform is an error.
-Expected<TriangleMesh> parse_3mf(std::string_view data, std::size_t max_triangles = 50'000'000);
+/// `objects` (optional) gets each build item's object (its name: the model's, PrusaSlicer's or
+/// OrcaSlicer's config's, or "object K" for item K from 1; instances of one object share an
+/// id) and the faces each item added.
+Expected<TriangleMesh> parse_3mf(std::string_view data, std::size_t max_triangles = 50'000'000,
+                                 PlateObjects* objects = nullptr);
 
 }  // namespace nonplanar::io

@@ -18,13 +18,16 @@ double weld_tolerance(const TriangleMesh& raw, double rel);
 /// Merge vertices closer than `tolerance` (mm) and drop faces that lose a corner to the
 /// merge (their count goes to *collapsed). Unreferenced vertices are removed.
 /// Exact duplicates are merged by hashing first, so only unique points meet the slower
-/// tolerant grid search; O(V) expected.
-TriangleMesh weld(TriangleMesh mesh, double tolerance, std::size_t* collapsed);
+/// tolerant grid search; O(V) expected. `tags` (one per face, or null/empty) keeps step with
+/// the faces.
+TriangleMesh weld(TriangleMesh mesh, double tolerance, std::size_t* collapsed,
+                  std::vector<int>* tags = nullptr);
 
 /// Removes faces that repeat another face with the same winding (an STL may hold a part twice
 /// over, or one facet 96k times: every later stage pays for each copy). A face and its
 /// reverse are both kept. Returns how many were removed; the vertices are left as they are.
-std::size_t remove_duplicate_faces(TriangleMesh& mesh);
+/// `tags` (one per face, or null/empty) keeps step with the faces.
+std::size_t remove_duplicate_faces(TriangleMesh& mesh, std::vector<int>* tags = nullptr);
 
 /// Faces whose height over their longest edge is below `tolerance` (needles and caps).
 std::size_t count_zero_area_faces(const TriangleMesh& mesh, double tolerance);

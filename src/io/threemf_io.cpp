@@ -2,8 +2,12 @@
 #include <Model/COM/NMR_DLLInterfaces.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
+#include <cstdint>
 #include <cstdio>
+#include <cstring>
 #include <functional>
+#include <optional>
 #include <string>
 #include <unordered_map>
 #include <vector>
@@ -173,7 +177,84 @@ bool append_object(NMR::PLib3MFModelObjectResource* obj, const Affine& xf, Trian
   return true;
 }
 
-Expected<TriangleMesh> parse_package(std::string_view data, std::size_t max_triangles) {
+// The object's name as the 3MF gives it ("" when none).
+std::string object_name(NMR::PLib3MFModelObjectResource* obj) {
+  ULONG need = 0;
+  if (NMR::lib3mf_object_getnameutf8(obj, nullptr, 0, &need) != 0 || need == 0) return "";
+  std::string s(need + 1, '\0');
+  if (NMR::lib3mf_object_getnameutf8(obj, s.data(), static_cast<ULONG>(s.size()), &need) != 0)
+    return "";
+  s.resize(std::min<std::size_t>(std::strlen(s.c_str()), 200));
+  return s;
+}
+
+// Object names the slicers keep beside the model: PrusaSlicer's
+// Metadata/Slic3r_PE_model.config (<object id="1" instances_count="2"> <metadata type="object"
+// key="name" value="cube.stl"/>: model objects 1 and 2 are its two instances), and OrcaSlicer's
+// and Bambu Studio's Metadata/model_settings.config (<object id="2"> <metadata key="name"
+// value="Cube"/>). PrusaSlicer leaves the model's own name attribute out.
+struct ConfigObject {
+  DWORD id = 0, instances = 1;
+  std::string name;
+};
+std::vector<ConfigObject> config_objects(std::string_view zip) {
+  std::vector<ConfigObject> out;
+  for (const char* entry : {"Metadata/Slic3r_PE_model.config", "Metadata/model_settings.config"}) {
+    const auto text = zip_entry(zip, entry, std::size_t(64) << 20);
+    if (!text) continue;
+    const std::string_view s = *text;
+    const std::string_view open = "<object id=\"";
+    for (std::size_t at = s.find(open); at != std::string_view::npos; at = s.find(open, at + 1)) {
+      const std::size_t end = s.find("</object>", at);
+      const std::string_view obj = s.substr(at, end == std::string_view::npos ? 0 : end - at);
+      const std::size_t key = obj.find("key=\"name\" value=\"");
+      if (key == std::string_view::npos) continue;
+      const std::size_t v0 = key + 18, v1 = obj.find('"', v0);
+      if (v1 == std::string_view::npos) continue;
+      ConfigObject c;
+      c.id = static_cast<DWORD>(std::strtoul(obj.data() + open.size(), nullptr, 10));
+      const std::size_t n = obj.substr(0, obj.find('>')).find("instances_count=\"");
+      if (n != std::string_view::npos)
+        c.instances = static_cast<DWORD>(
+            std::clamp(std::strtoul(obj.data() + n + 17, nullptr, 10), 1ul, 1000000ul));
+      c.name = std::string(obj.substr(v0, std::min<std::size_t>(v1 - v0, 200)));
+      out.push_back(std::move(c));
+    }
+  }
+  return out;
+}
+
+// Whose instance a build item is: PrusaSlicer's object (by its config) or else the model's
+// own object resource; its name and number, and which copy.
+class ItemNames {
+ public:
+  explicit ItemNames(std::string_view zip) : config_(config_objects(zip)) {}
+  PlateObject next(NMR::PLib3MFModelObjectResource* obj, std::size_t item) {
+    DWORD id = 0;
+    NMR::lib3mf_resource_getresourceid(obj, &id);
+    PlateObject p;
+    p.name = object_name(obj);
+    std::uint64_t source = (std::uint64_t(1) << 32) | id;  // the resource itself
+    for (std::size_t c = 0; c < config_.size(); ++c)
+      if (id >= config_[c].id && id - config_[c].id < config_[c].instances) {
+        source = c;
+        if (p.name.empty()) p.name = config_[c].name;
+        break;
+      }
+    if (p.name.empty()) p.name = "object " + std::to_string(item + 1);
+    const auto [it, fresh] = ids_.emplace(source, static_cast<int>(ids_.size()));
+    p.id = it->second;
+    p.copy = copies_[source]++;
+    return p;
+  }
+
+ private:
+  std::vector<ConfigObject> config_;
+  std::unordered_map<std::uint64_t, int> ids_, copies_;
+};
+
+Expected<TriangleMesh> parse_package(std::string_view data, std::size_t max_triangles,
+                                     PlateObjects* objects) {
   Handle model, reader;
   if (NMR::lib3mf_createmodel(&model.p) != 0 ||
       NMR::lib3mf_model_queryreader(model.p, "3mf", &reader.p) != 0)
@@ -211,6 +292,7 @@ Expected<TriangleMesh> parse_package(std::string_view data, std::size_t max_tria
   Handle again;
   if (NMR::lib3mf_model_getbuilditems(model.p, &again.p) != 0)
     return Error{Status::parse_error, "3MF build has no items"};
+  std::optional<ItemNames> names;  // read when first needed
   mesh.vertices.reserve(static_cast<std::size_t>(3 * triangles));
   mesh.faces.reserve(static_cast<std::size_t>(triangles));
   while (NMR::lib3mf_builditemiterator_movenext(again.p, &has_next) == 0 && has_next) {
@@ -230,6 +312,11 @@ Expected<TriangleMesh> parse_package(std::string_view data, std::size_t max_tria
     }
     if (!append_object(obj.p, xf, mesh, 0, &err))
       return Error{Status::parse_error, "3MF object: " + err};
+    if (objects) {
+      if (!names) names.emplace(data);
+      objects->face.resize(mesh.faces.size(), static_cast<int>(objects->items.size()));
+      objects->items.push_back(names->next(obj.p, objects->items.size()));
+    }
   }
   DWORD unit = NMR::MODELUNIT_MILLIMETER;
   NMR::lib3mf_model_getunit(model.p, &unit);
@@ -245,7 +332,8 @@ Expected<TriangleMesh> parse_package(std::string_view data, std::size_t max_tria
 // deep would still cost lib3mf a walk per path).
 constexpr double kMaxInstances = 1e6;
 
-Expected<TriangleMesh> parse_3mf(std::string_view data, std::size_t max_triangles) {
+Expected<TriangleMesh> parse_3mf(std::string_view data, std::size_t max_triangles,
+                                 PlateObjects* objects) {
   if (data.empty()) return Error{Status::parse_error, "file is empty"};
   // Counted from the XML before lib3mf reads it (it walks nested components once per object,
   // and cannot be cancelled): a 9-level bomb of a few KB took it 37 s.
@@ -260,12 +348,19 @@ Expected<TriangleMesh> parse_3mf(std::string_view data, std::size_t max_triangle
       return Error{Status::invalid_mesh, msg};
     }
   }
-  auto r = parse_package(data, max_triangles);
-  if (r || r.error().message.rfind("not a valid 3MF file", 0) != 0) return r;
+  PlateObjects found;
+  auto r = parse_package(data, max_triangles, &found);
+  if (r || r.error().message.rfind("not a valid 3MF file", 0) != 0) {
+    if (r && objects) *objects = std::move(found);
+    return r;
+  }
   // A package lib3mf refuses for a part it names but lacks (PrusaSlicer's command line names
   // a thumbnail it never wrote): read again without such relationships.
   if (auto fixed = drop_dangling_relationships(data, nullptr))
-    if (auto again = parse_package(*fixed, max_triangles)) return again;
+    if (auto again = parse_package(*fixed, max_triangles, &(found = {}))) {
+      if (objects) *objects = std::move(found);
+      return again;
+    }
   return r;
 }
 

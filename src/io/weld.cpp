@@ -61,7 +61,9 @@ class IndexTable {
 
 }  // namespace
 
-TriangleMesh weld(TriangleMesh mesh, double tolerance, std::size_t* collapsed) {
+TriangleMesh weld(TriangleMesh mesh, double tolerance, std::size_t* collapsed,
+                  std::vector<int>* tags) {
+  const bool tagged = tags && tags->size() == mesh.faces.size();
   std::vector<Vec3>& pts = mesh.vertices;
   const std::size_t n = pts.size();
   // Pass 1: exact duplicates (an STL repeats each shared vertex bit for bit; the binary
@@ -137,14 +139,17 @@ TriangleMesh weld(TriangleMesh mesh, double tolerance, std::size_t* collapsed) {
   // Remap faces in place, dropping those that lost a corner to the merge.
   std::size_t kept = 0;
   std::vector<char> used(no, 0);
-  for (const auto& f : mesh.faces) {
+  for (std::size_t i = 0; i < mesh.faces.size(); ++i) {
+    const auto& f = mesh.faces[i];
     const std::array<int, 3> g = {to_out[map[f[0]]], to_out[map[f[1]]], to_out[map[f[2]]]};
     if (g[0] == g[1] || g[1] == g[2] || g[0] == g[2]) continue;
     used[g[0]] = used[g[1]] = used[g[2]] = 1;
+    if (tagged) (*tags)[kept] = (*tags)[i];
     mesh.faces[kept++] = g;
   }
   if (collapsed) *collapsed = mesh.faces.size() - kept;
   mesh.faces.resize(kept);
+  if (tagged) tags->resize(kept);
   // Drop points no face uses (OBJ/OFF may list extras; collapsed faces leave some).
   std::vector<int> remap(no, -1);
   std::size_t m = 0;
@@ -181,7 +186,8 @@ double weld_tolerance(const TriangleMesh& raw, double rel) {
   return std::min(rel * (hi - lo).norm(), 1e-3 * *mid);
 }
 
-std::size_t remove_duplicate_faces(TriangleMesh& mesh) {
+std::size_t remove_duplicate_faces(TriangleMesh& mesh, std::vector<int>* tags) {
+  const bool tagged = tags && tags->size() == mesh.faces.size();
   // A face's key: its corners rotated to start at the smallest, so the winding is kept.
   auto key = [](std::array<int, 3> f) {
     std::rotate(f.begin(), std::min_element(f.begin(), f.end()), f.end());
@@ -199,10 +205,12 @@ std::size_t remove_duplicate_faces(TriangleMesh& mesh) {
     const std::size_t s = table.probe(hash(k), [&](int o) { return key(mesh.faces[o]) == k; });
     if (table.slot(s) >= 0) continue;  // the same face, wound the same way, again
     mesh.faces[kept] = mesh.faces[i];
+    if (tagged) (*tags)[kept] = (*tags)[i];
     table.slot(s) = static_cast<int>(kept++);
   }
   const std::size_t removed = mesh.faces.size() - kept;
   mesh.faces.resize(kept);
+  if (tagged) tags->resize(kept);
   return removed;
 }
 

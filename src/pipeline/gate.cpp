@@ -32,6 +32,7 @@ std::optional<Error> nothing_to_print(const SliceResult& r, const TriangleMesh& 
 
 Expected<void> write_program(SliceResult& r, const SliceJob& job, const Context& ctx) {
   if (!r.gcode.empty()) return {};
+  group_by_object(r.layers, job.objects);
   std::vector<std::string> header = r.header;
   header.insert(header.end(), job.header.begin(), job.header.end());
   auto text = make_gcode(r.layers, job.print, header, ctx);

@@ -1,7 +1,9 @@
 #include <Model/COM/NMR_DLLInterfaces.h>
 #include <gtest/gtest.h>
 
+#include <array>
 #include <limits>
+#include <string>
 
 #include "io/readers.hpp"
 #include "support/files.hpp"
@@ -79,6 +81,53 @@ TEST(ThreeMf, BuildItemsAndTransformsAreApplied) {
   EXPECT_NEAR(box.min.x(), 0.0, 1e-6);
   EXPECT_NEAR(box.max.x(), 11.0, 1e-6);
   EXPECT_NEAR(box.max.z(), 6.0, 1e-6);
+}
+
+// #16: a plate's objects stay apart. Each build item is an object with its object's name
+// ("object K" without one), and each face knows its object through welding.
+TEST(ThreeMf, SeveralObjectsKeepTheirNamesAndFaces) {
+  const auto dir = test::temp_dir("3mf_objects");
+  NMR::PLib3MFModel* model = nullptr;
+  ASSERT_EQ(NMR::lib3mf_createmodel(&model), 0);
+  NMR::PLib3MFModelMeshObject* a = add_cube(model);
+  NMR::PLib3MFModelMeshObject* b = add_cube(model);
+  ASSERT_EQ(NMR::lib3mf_object_setnameutf8(a, "left cube"), 0);
+  NMR::MODELTRANSFORM at = identity(), bt = identity(), ct = identity();
+  bt.m_fFields[0][3] = 10, ct.m_fFields[1][3] = 10;
+  NMR::PLib3MFModelBuildItem *ia = nullptr, *ib = nullptr, *ic = nullptr;
+  ASSERT_EQ(NMR::lib3mf_model_addbuilditem(model, a, &at, &ia), 0);
+  ASSERT_EQ(NMR::lib3mf_model_addbuilditem(model, b, &bt, &ib), 0);
+  ASSERT_EQ(NMR::lib3mf_model_addbuilditem(model, a, &ct, &ic), 0);  // a second instance
+  write_model(model, dir / "plate.3mf");
+  for (auto* p : {static_cast<NMR::PLib3MFBase*>(ia), ib, ic, a, b, model}) NMR::lib3mf_release(p);
+
+  auto r = load_mesh(dir / "plate.3mf", test::unplaced(), {});
+  ASSERT_TRUE(r) << r.error().message;
+  ASSERT_EQ(r->objects.items.size(), 3u);
+  const std::vector<std::string> names = {"left cube", "object 2", "left cube"};
+  const std::vector<int> ids = {0, 1, 0}, copies = {0, 0, 1};  // the third: cube a again
+  for (std::size_t k = 0; k < 3; ++k) {
+    EXPECT_EQ(r->objects.items[k].name, names[k]);
+    EXPECT_EQ(r->objects.items[k].id, ids[k]);
+    EXPECT_EQ(r->objects.items[k].copy, copies[k]);
+  }
+  ASSERT_EQ(r->objects.face.size(), r->mesh.faces.size());
+  std::array<int, 3> faces{};
+  for (std::size_t f = 0; f < r->mesh.faces.size(); ++f) {
+    const int k = r->objects.face[f];
+    ASSERT_TRUE(k >= 0 && k < 3);
+    ++faces[static_cast<std::size_t>(k)];
+    Vec3 c = Vec3::Zero();
+    for (int v : r->mesh.faces[f]) c += r->mesh.vertices[static_cast<std::size_t>(v)] / 3;
+    EXPECT_EQ(k, c.x() > 5 ? 1 : c.y() > 5 ? 2 : 0);
+  }
+  EXPECT_EQ(faces, (std::array<int, 3>{12, 12, 12}));
+  // One object: nothing to tell apart.
+  ASSERT_TRUE(write_3mf(dir / "one.3mf", test::box({0, 0, 0}, {1, 1, 1})));
+  auto one = load_mesh(dir / "one.3mf", test::unplaced(), {});
+  ASSERT_TRUE(one);
+  EXPECT_FALSE(one->objects.several());
+  EXPECT_TRUE(one->objects.face.empty());
 }
 
 TEST(ThreeMfErrors, ZipThatIsNot3mfAndRandomBytes) {
