@@ -48,6 +48,18 @@ std::optional<Error> check(const LayerParams& p) {
   return std::nullopt;
 }
 
+// Whether band `a`'s β may be non-zero at a column check_blend looks at for band `b` (the
+// nodes of b's blend raster). Band::beta is 0 two cells and more before a's raster and one
+// cell and more past its last node; a cell more either way for rounding.
+bool reaches(const Band& a, const Band& b) {
+  const Vec2 a_lo = a.blend_origin - Vec2(3, 3) * a.blend_cell;
+  const Vec2 a_hi = a.blend_origin + Vec2(a.blend_nx + 2, a.blend_ny + 2) * a.blend_cell;
+  const Vec2 b_lo = b.blend_origin;
+  const Vec2 b_hi = b.blend_origin + Vec2(b.blend_nx, b.blend_ny) * b.blend_cell;
+  return a_lo.x() <= b_hi.x() && b_lo.x() <= a_hi.x() && a_lo.y() <= b_hi.y() &&
+         b_lo.y() <= a_hi.y();
+}
+
 // Layers through the blend zone of band `b` (0 < β < 1) where there is material: thickness
 // and slope. Returns a reason, or empty.
 std::string check_blend(const BandedField& field, const Band& b, const ColumnCaster& columns,
@@ -192,16 +204,27 @@ Expected<LayerPlan> plan_layers(const TriangleMesh& mesh, const Analysis& analys
       bands.push_back(std::move(r.band));
     }
   }
-  // Check each blend zone in the field of all bands; drop offenders until none is left.
+  // Check each blend zone in the field of all bands; drop offenders until none is left. A
+  // band that passed keeps its verdict while no band dropped reaches its blend zone: where a
+  // band's β is 0 the field's sums do not change without it (up to the field's 64 bands).
+  // On the bunny the same passing bands were checked again after each of 5 drops (0.7 s).
+  std::vector<char> passed(bands.size(), 0);
   for (bool changed = true; changed;) {
     changed = false;
     const BandedField field(planar, bands);
     for (std::size_t b = 0; b < bands.size(); ++b) {
+      if (passed[b]) continue;
       const std::string why = check_blend(field, bands[b], columns, params);
-      if (why.empty()) continue;
+      if (why.empty()) {
+        passed[b] = bands.size() <= 64;
+        continue;
+      }
       plan.fallbacks.push_back({plan.stacks[b].patch, why});
+      for (std::size_t o = 0; o < bands.size(); ++o)
+        if (passed[o] && reaches(bands[b], bands[o])) passed[o] = 0;
       plan.stacks.erase(plan.stacks.begin() + static_cast<long>(b));
       bands.erase(bands.begin() + static_cast<long>(b));
+      passed.erase(passed.begin() + static_cast<long>(b));
       changed = true;
       break;
     }
