@@ -46,7 +46,8 @@ class PrintTimer {
   void reserve(std::size_t lines, std::size_t moves);
   /// The program's next line, with its move when it is a G0/G1 (else null).
   void line(const GcodeLine& l, const GcodeMove* move);
-  /// The estimate of the lines given (line_start: one entry per line, and the total).
+  /// The estimate of the lines given (line_start: one entry per line, and the total). Once:
+  /// the timer hands its memory over and is spent.
   PrintTime finish();
 
  private:

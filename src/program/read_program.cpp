@@ -335,9 +335,23 @@ std::vector<GcodeProblem> for_each_gcode_move(std::string_view text,
   return std::move(p.problems);
 }
 
+namespace {
+// Room for every G line of the text: the moves' vector never grows by copying (the bunny's
+// gate peaked at 163 MB so, for 72 MB of moves), and the room no move takes is never touched,
+// so it costs address space, not memory.
+std::vector<PrintMove> room_for_moves(std::string_view text) {
+  std::size_t g = 1;
+  for (std::size_t k = 0; k < text.size(); ++k)
+    g += text[k] == '\n' && k + 1 < text.size() && (text[k + 1] | 0x20) == 'g';
+  std::vector<PrintMove> moves;
+  moves.reserve(g);
+  return moves;
+}
+}  // namespace
+
 std::vector<PrintMove> read_print_moves(std::string_view text,
                                         const std::function<bool(const GcodeMove&)>& keep) {
-  std::vector<PrintMove> moves;
+  std::vector<PrintMove> moves = room_for_moves(text);
   for_each_gcode_move(text, [&](const GcodeMove& g) {
     if (!keep || keep(g)) moves.push_back(print_move(g));
   });
@@ -345,7 +359,7 @@ std::vector<PrintMove> read_print_moves(std::string_view text,
 }
 
 Expected<std::vector<PrintMove>> read_gcode_moves(std::string_view text) {
-  std::vector<PrintMove> moves;
+  std::vector<PrintMove> moves = room_for_moves(text);
   const auto problems =
       for_each_gcode_move(text, [&](const GcodeMove& g) { moves.push_back(print_move(g)); });
   for (const GcodeProblem& q : problems)
