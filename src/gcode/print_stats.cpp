@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "core/huge_pages.hpp"
 #include "core/text_tokens.hpp"
 #include "nonplanar/gcode.hpp"
 
@@ -143,6 +144,7 @@ std::string with_print_stats(std::string_view gcode, const PrintConfig& c, Print
 
   std::string out;
   out.reserve(gcode.size() + gcode.size() / 50 + block.size());
+  advise_huge_pages(out.data(), out.capacity());
   bool placed = false, finished = false;
   if (progress) out += progress_at(0);  // first, as PrusaSlicer writes it
   auto finish = [&] {  // 100 % once the print is done, before the footer at the latest

@@ -2,6 +2,7 @@
 // classic-jerk planner), with the whole program as its look-ahead instead of 64 blocks.
 // Notation: v speeds (mm/s), a acceleration (mm/s²), d a block's length (mm); axes X Y Z E.
 #include "nonplanar/print_time.hpp"
+#include "core/huge_pages.hpp"
 
 #include <algorithm>
 #include <array>
@@ -200,8 +201,8 @@ PrintTimer::PrintTimer(const MachineLimits& limits) : impl_(std::make_unique<Imp
 PrintTimer::~PrintTimer() = default;
 
 void PrintTimer::reserve(std::size_t lines, std::size_t moves) {
-  impl_->extra.reserve(lines);
-  impl_->blocks.reserve(moves);
+  reserve_huge(impl_->extra, lines);
+  reserve_huge(impl_->blocks, moves);
 }
 
 void PrintTimer::line(const GcodeLine& l, const GcodeMove* move) {

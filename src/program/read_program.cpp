@@ -5,6 +5,7 @@
 #include <cctype>
 #include <cmath>
 
+#include "core/huge_pages.hpp"
 #include "core/text_tokens.hpp"
 #include "nonplanar/program.hpp"
 
@@ -344,7 +345,7 @@ std::vector<PrintMove> room_for_moves(std::string_view text) {
   for (std::size_t k = 0; k < text.size(); ++k)
     g += text[k] == '\n' && k + 1 < text.size() && (text[k + 1] | 0x20) == 'g';
   std::vector<PrintMove> moves;
-  moves.reserve(g);
+  reserve_huge(moves, g);
   return moves;
 }
 }  // namespace
