@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <optional>
 #include <sstream>
 #include <tuple>
@@ -11,6 +12,19 @@
 
 namespace nonplanar {
 namespace {
+
+// The keys the built-in engine's time and filament figures read from the profile (they have
+// no field of their own): PrusaSlicer's machine limits, its stealth mode and M73 switches, and
+// the filament's density and cost.
+bool read_by_print_stats(const std::string& key) {
+  static const char* const prefixes[] = {"machine_max_feedrate_", "machine_max_acceleration_",
+                                         "machine_max_jerk_"};
+  for (const char* p : prefixes)
+    if (key.rfind(p, 0) == 0 && key.size() > std::strlen(p)) return true;
+  return key == "machine_min_extruding_rate" || key == "machine_min_travel_rate" ||
+         key == "silent_mode" || key == "remaining_times" || key == "filament_density" ||
+         key == "filament_cost";
+}
 
 Error bad(const std::string& key, const std::string& why) {
   return Error{Status::invalid_argument, key + ": " + why};
@@ -192,6 +206,20 @@ Expected<bool> set_value(PrintConfig& c, const std::string& key, const std::stri
       g.flavor = GcodeFlavor::reprapfirmware;
     else
       return bad(key, "'" + v + "' is not marlin2, klipper or reprapfirmware");
+    return true;
+  }
+  if (read_by_print_stats(key)) {  // gcode/print_stats.cpp reads them from the profile
+    std::size_t start = 0;
+    for (;;) {
+      const std::size_t comma = value.find(',', start);
+      const std::string item =
+          value.substr(start, comma == std::string::npos ? comma : comma - start);
+      const auto v = core::parse_double(item);
+      if (!v || !std::isfinite(*v) || *v < 0)
+        return bad(key, "'" + item + "' is not a number >= 0 (or a list of them, one per mode)");
+      if (comma == std::string::npos) break;
+      start = comma + 1;
+    }
     return true;
   }
   if (key == "gcode_label_objects") {  // 2.5's 0/1, 2.6's names; object_labels.hpp reads it

@@ -130,6 +130,29 @@ TEST(Config, EverySettingHasARange) {
   EXPECT_TRUE(validate_config(thin));
 }
 
+// #16 item 2: the keys the time estimate reads from the profile are settings of their own, so
+// `--set machine_max_acceleration_extruding=500` is taken (it was "unknown setting"), takes
+// effect, and a bad value is refused naming the key.
+TEST(Config, MachineLimitsAreSettingsTheEstimateReads) {
+  PrintConfig c;
+  for (const char* key : {"machine_max_acceleration_extruding", "machine_max_jerk_x",
+                          "machine_max_feedrate_e", "machine_min_travel_rate", "silent_mode",
+                          "remaining_times", "filament_density", "filament_cost"}) {
+    auto r = set_config_value(c, key, "1");
+    ASSERT_TRUE(r) << key;
+    EXPECT_TRUE(*r) << key;
+  }
+  ASSERT_TRUE(set_config_value(c, "machine_max_acceleration_extruding", "500,960"));
+  EXPECT_EQ(machine_limits(c).accel_extruding, 500);
+  EXPECT_EQ(machine_limits(c, 1).accel_extruding, 960);
+  auto bad = set_config_value(c, "machine_max_jerk_y", "8,fast");
+  ASSERT_FALSE(bad);
+  EXPECT_NE(bad.error().message.find("machine_max_jerk_y: 'fast' is not a number"),
+            std::string::npos)
+      << bad.error().message;
+  EXPECT_FALSE(*set_config_value(c, "machine_max_jerk_", "3"));  // no axis: not ours
+}
+
 TEST(Config, UnknownFillPatternIsAnErrorAndPrusaSlicersAreNoted) {
   PrintConfig c;
   auto typo = set_config_value(c, "fill_pattern", "nosuchpattern");
