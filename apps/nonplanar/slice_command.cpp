@@ -126,13 +126,17 @@ int run(const SliceOptions& o) {
   job.header.push_back("model: " + o.mesh.model);
   if (loaded->objects.several()) {
     // A 3MF's build items, where it placed them: each layer prints them one by one, each
-    // with its own label. Another slicer gets the normalised part as one object.
-    if (job.engine.engine == Engine::builtin) {
+    // with its own label. Another slicer gets the normalised part as one object, and so does
+    // a plate of more than 256 objects (each path looks at every object's box).
+    constexpr std::size_t kMostObjects = 256;
+    if (job.engine.engine == Engine::builtin && loaded->objects.items.size() <= kMostObjects) {
       cfg.gcode.objects = job.print.gcode.objects = loaded->objects.items;
       job.objects = object_outlines(loaded->mesh, loaded->objects);
     } else if (!o.mesh.quiet) {
-      std::fprintf(stderr, "notice: %s: its %zu objects go to %s as one object\n",
-                   o.mesh.model.c_str(), loaded->objects.items.size(), o.engine.c_str());
+      std::fprintf(stderr, "notice: %s: its %zu objects print as one object%s\n",
+                   o.mesh.model.c_str(), loaded->objects.items.size(),
+                   job.engine.engine == Engine::builtin ? " (more than 256)"
+                                                        : (" through " + o.engine).c_str());
     }
   }
   auto result = slice_model(loaded->mesh, job, ctx);

@@ -228,19 +228,24 @@ std::vector<ConfigObject> config_objects(std::string_view zip) {
 // own object resource; its name and number, and which copy.
 class ItemNames {
  public:
-  explicit ItemNames(std::string_view zip) : config_(config_objects(zip)) {}
+  explicit ItemNames(std::string_view zip) : config_(config_objects(zip)) {
+    // By first id, each found in log time (a hostile plate may hold a million objects).
+    std::stable_sort(config_.begin(), config_.end(),
+                     [](const ConfigObject& a, const ConfigObject& b) { return a.id < b.id; });
+  }
   PlateObject next(NMR::PLib3MFModelObjectResource* obj, std::size_t item) {
     DWORD id = 0;
     NMR::lib3mf_resource_getresourceid(obj, &id);
     PlateObject p;
     p.name = object_name(obj);
     std::uint64_t source = (std::uint64_t(1) << 32) | id;  // the resource itself
-    for (std::size_t c = 0; c < config_.size(); ++c)
-      if (id >= config_[c].id && id - config_[c].id < config_[c].instances) {
-        source = c;
-        if (p.name.empty()) p.name = config_[c].name;
-        break;
-      }
+    // The config object with the greatest first id at or below this one, if it reaches it.
+    auto c = std::upper_bound(config_.begin(), config_.end(), id,
+                              [](DWORD v, const ConfigObject& o) { return v < o.id; });
+    if (c != config_.begin() && id - (--c)->id < c->instances) {
+      source = static_cast<std::uint64_t>(c - config_.begin());
+      if (p.name.empty()) p.name = c->name;
+    }
     if (p.name.empty()) p.name = "object " + std::to_string(item + 1);
     const auto [it, fresh] = ids_.emplace(source, static_cast<int>(ids_.size()));
     p.id = it->second;
