@@ -27,8 +27,8 @@ cd "$build_dir"
 # Left out here (scripts/test.sh and scripts/sanitize.sh run them): tests whose time is
 # another program's (PrusaSlicer slicing stock presets or a prepared part, Chromium drawing the
 # preview); the threaded stages they reach are run under TSan by the slice and engine tests.
-# The bunny's four shells take 3.5 minutes here; scripts/sanitize.sh runs them under ASan, and
-# the threads they reach are the ones the shell tests here run.
+# The bunny's four shells take 3.5 minutes here (and leave ASan's run too); the threads they
+# reach are the ones the other shell tests run.
 ctest --output-on-failure -j"$(nproc)" --timeout 1800 ${1:+-R "$1"} \
   -E '^(NonplanarPrint\.SharedBunny|Preview\.TheBrowser|StockPresets\.(CurvedTops|TheWing)|PostProcessRoute\.)'
 
