@@ -43,7 +43,7 @@ TEST(PlatePrint, EachObjectPrintsInsideItsOwnLabelAndTheDomeStaysCurved) {
     label.push_back(now);
   }
   EXPECT_EQ(now, -1);
-  EXPECT_EQ(r->gcode.find("M486 T2\n") != std::string::npos, true);
+  EXPECT_NE(r->gcode.find("M486 T2\n"), std::string::npos);
   auto moves = read_gcode_moves(r->gcode);
   ASSERT_TRUE(moves) << moves.error().message;
   std::size_t checked[2] = {0, 0}, stray = 0;
