@@ -19,6 +19,9 @@ struct MachineLimits {
   double accel_extruding = 1500, accel_retracting = 1500, accel_travel = 1250;
   double jerk_x = 10, jerk_y = 10, jerk_z = 0.2, jerk_e = 2.5;  ///< mm/s
   double min_extruding_rate = 0, min_travel_rate = 0;           ///< mm/s
+  /// Marlin 2's junction deviation (machine_max_junction_deviation, M205 J), mm. Above 0 it
+  /// replaces the jerk limits at every junction, as in the firmware and PrusaSlicer 2.6+.
+  double junction_deviation = 0;
 };
 
 struct PrintTime {
@@ -29,8 +32,9 @@ struct PrintTime {
 };
 
 /// Every G0/G1 becomes a block with Marlin's trapezoid: entry speeds bounded by the jerk
-/// limits at each junction, then a backward and a forward pass over the whole program so
-/// each block can reach its neighbours' speeds within its acceleration.
+/// limits (or the junction deviation) at each junction, then a backward and a forward pass
+/// over the whole program so each block can reach its neighbours' speeds within its
+/// acceleration.
 PrintTime estimate_print_time(const GcodeProgram& program, const MachineLimits& limits);
 
 /// The same estimate fed one line at a time, so a large file need not be held read (a

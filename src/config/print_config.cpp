@@ -22,8 +22,8 @@ bool read_by_print_stats(const std::string& key) {
   for (const char* p : prefixes)
     if (key.rfind(p, 0) == 0 && key.size() > std::strlen(p)) return true;
   return key == "machine_min_extruding_rate" || key == "machine_min_travel_rate" ||
-         key == "silent_mode" || key == "remaining_times" || key == "filament_density" ||
-         key == "filament_cost";
+         key == "machine_max_junction_deviation" || key == "silent_mode" ||
+         key == "remaining_times" || key == "filament_density" || key == "filament_cost";
 }
 
 Error bad(const std::string& key, const std::string& why) {

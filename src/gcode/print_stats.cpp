@@ -75,7 +75,8 @@ MachineLimits machine_limits(const PrintConfig& c, int mode) {
       {"machine_max_jerk_z", &m.jerk_z},
       {"machine_max_jerk_e", &m.jerk_e},
       {"machine_min_extruding_rate", &m.min_extruding_rate},
-      {"machine_min_travel_rate", &m.min_travel_rate}};
+      {"machine_min_travel_rate", &m.min_travel_rate},
+      {"machine_max_junction_deviation", &m.junction_deviation}};
   for (const auto& [key, field] : keys)
     if (auto v = nth_number(c, key, mode)) *field = *v;
   // PrusaSlicer 2.5 writes a travel acceleration of 0 for "as extruding".

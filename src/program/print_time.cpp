@@ -1,6 +1,8 @@
 // The time estimate of print_time.hpp: PrusaSlicer's GCodeProcessor planner (itself Marlin's
-// classic-jerk planner), with the whole program as its look-ahead instead of 64 blocks.
-// Notation: v speeds (mm/s), a acceleration (mm/s²), d a block's length (mm); axes X Y Z E.
+// planner: classic jerk, or Marlin 2's junction deviation), with the whole program as its
+// look-ahead instead of 64 blocks.
+// Notation: v speeds (mm/s), a acceleration (mm/s²), d a block's length (mm); axes X Y Z E;
+// δ the junction deviation (mm), θ the angle between two moves' directions.
 #include "nonplanar/print_time.hpp"
 #include "core/huge_pages.hpp"
 
@@ -56,6 +58,7 @@ class Limits {
       : feed_{m.feed_x, m.feed_y, m.feed_z, m.feed_e},
         accel_{m.accel_x, m.accel_y, m.accel_z, m.accel_e},
         jerk_{m.jerk_x, m.jerk_y, m.jerk_z, m.jerk_e},
+        deviation_(m.junction_deviation),
         max_print_(m.accel_extruding),
         max_travel_(m.accel_travel),
         print_(m.accel_extruding),
@@ -77,6 +80,7 @@ class Limits {
       if (cmd == "M201" && axis >= 0) accel_[axis] = *v;
       if (cmd == "M203" && axis >= 0) feed_[axis] = *v;
       if (cmd == "M205" && axis >= 0) jerk_[axis] = *v;
+      if (cmd == "M205" && k == 'J') deviation_ = *v;  // Marlin 2 (PrusaSlicer's viewer skips it)
       if (cmd == "M204") {  // capped by the profile's limits, as PrusaSlicer caps them
         auto cap = [](double x, double max) { return max > 0 ? std::min(x, max) : x; };
         if (k == 'S' || k == 'P') print_ = cap(*v, max_print_);
@@ -86,6 +90,7 @@ class Limits {
     }
   }
   Axes feed_, accel_, jerk_;
+  double deviation_;
   double max_print_, max_travel_, print_, retract_, travel_, min_extruding_, min_travel_;
 };
 
@@ -93,7 +98,70 @@ class Limits {
 struct Previous {
   double feed = 0, safe = 0;
   Axes axis{0, 0, 0, 0};  // signed axis speeds
+  Axes unit{0, 0, 0, 0};  // its XYZE per mm of its length (junction deviation's direction)
 };
+
+// Classic jerk: the highest speed at which no axis changes speed by more than its jerk
+// across the junction (PrusaSlicer's process_G1, Marlin 1's planner).
+double jerk_junction(const Axes& axis, double v, double safe, const Axes& jerk,
+                     const Previous& prev) {
+  const bool prev_faster = prev.feed > v;
+  const double slower = prev_faster ? v / prev.feed : prev.feed / v;
+  double junction = prev_faster ? v : prev.feed;
+  double factor = 1;
+  bool limited = false;
+  for (int k = 0; k < 4; ++k) {
+    double v_exit = prev.axis[k], v_entry = axis[k];
+    if (prev_faster) v_exit *= slower;
+    if (limited) v_exit *= factor, v_entry *= factor;
+    // Coasting on, or reversing: the jerk the axis feels at the junction.
+    const double j =
+        v_exit > v_entry
+            ? (v_entry > 0 || v_exit < 0 ? v_exit - v_entry : std::max(v_exit, -v_entry))
+            : (v_entry < 0 || v_exit > 0 ? v_entry - v_exit : std::max(-v_exit, v_entry));
+    if (j > jerk[k]) factor *= jerk[k] / j, limited = true;
+  }
+  if (limited) junction *= factor;
+  const double threshold = junction * 0.99;
+  if (prev.safe > threshold && safe > threshold) junction = safe;
+  return junction;
+}
+
+// acos(t) for t in [0, 1) as Marlin 2 computes it for short sharp junctions: π/2 minus
+// W. R. Franklin's minimax polynomial for asin (error ≤ 0.033 rad; it never returns less
+// than 0.033, which keeps a nearly straight junction's arc limit finite).
+double firmware_acos(double t) {
+  const double asin_t =
+      0.032843707 +
+      t * (-1.451838349 +
+           t * (29.66153956 +
+                t * (-131.1123477 + t * (262.8130562 + t * (-242.7199627 + t * 84.31466202)))));
+  return M_PI / 2 - asin_t;
+}
+
+// Marlin 2's junction deviation δ: the corner is driven as an arc that stays within δ of it,
+// at the junction's acceleration a_j: v² = a_j δ sin(θ/2) / (1 − sin(θ/2)), θ the angle between
+// the two directions; a short move at a sharp corner as an arc through its length instead.
+// Never faster than either move. A full reversal stops.
+double deviation_junction(const Axes& unit, double v, double a, double d, const Axes& accel,
+                          double deviation, const Previous& prev) {
+  double cos_t = 0;  // cosine of the corner's inner angle (the previous direction reversed)
+  for (int k = 0; k < 4; ++k) cos_t -= prev.unit[k] * unit[k];
+  if (cos_t > 0.999999) return 0;
+  cos_t = std::max(cos_t, -0.999999);
+  Axes turn{};
+  double turn_norm = 0;
+  for (int k = 0; k < 4; ++k) turn[k] = unit[k] - prev.unit[k], turn_norm += turn[k] * turn[k];
+  turn_norm = std::sqrt(turn_norm);
+  double a_j = a;  // the acceleration the turn may use: each axis within its own limit
+  for (int k = 0; k < 4; ++k)
+    if (turn[k] != 0 && accel[k] > 0) a_j = std::min(a_j, std::abs(accel[k] * turn_norm / turn[k]));
+  const double sin_half = std::sqrt(0.5 * (1 - cos_t));
+  double v2 = a_j * deviation * sin_half / (1 - sin_half);
+  if (d < 1 && cos_t < -0.7071067812) v2 = std::min(v2, d * a_j / firmware_acos(-cos_t));
+  v2 = std::min({v2, v * v, prev.feed * prev.feed});
+  return std::sqrt(v2);
+}
 
 // One G0/G1 as a block with its junction speed (PrusaSlicer's process_G1), or none when it
 // moves nothing.
@@ -107,8 +175,8 @@ bool make_block(const GcodeMove& m, const Limits& L, Previous& prev, bool first,
   const bool extruding = m.de > 0 && !e_only;
   double v = std::isnan(m.feed) ? 25.0 : m.feed / 60.0;
   v = std::max(v, extruding ? L.min_extruding_ : L.min_travel_);
-  Axes axis{};
-  for (int k = 0; k < 4; ++k) axis[k] = v * delta[k] / d;
+  Axes axis{}, unit{};
+  for (int k = 0; k < 4; ++k) axis[k] = v * delta[k] / d, unit[k] = delta[k] / d;
   double scale = 1;
   for (int k = 0; k < 4; ++k)
     if (L.feed_[k] > 0 && std::abs(axis[k]) > L.feed_[k])
@@ -119,37 +187,22 @@ bool make_block(const GcodeMove& m, const Limits& L, Previous& prev, bool first,
   for (int k = 0; k < 4; ++k)
     if (L.accel_[k] > 0 && std::abs(delta[k]) > 1e-12 && a * std::abs(delta[k]) / d > L.accel_[k])
       a = L.accel_[k] * d / std::abs(delta[k]);
-  double safe = v;
-  for (int k = 0; k < 4; ++k)
-    if (std::abs(axis[k]) > L.jerk_[k]) safe = std::min(safe, L.jerk_[k]);
-  double junction = safe;
-  if (!first && prev.feed > 1e-4) {
-    const bool prev_faster = prev.feed > v;
-    const double slower = prev_faster ? v / prev.feed : prev.feed / v;
-    junction = prev_faster ? v : prev.feed;
-    double factor = 1;
-    bool limited = false;
-    for (int k = 0; k < 4; ++k) {
-      double v_exit = prev.axis[k], v_entry = axis[k];
-      if (prev_faster) v_exit *= slower;
-      if (limited) v_exit *= factor, v_entry *= factor;
-      // Coasting on, or reversing: the jerk the axis feels at the junction.
-      const double jerk =
-          v_exit > v_entry
-              ? (v_entry > 0 || v_exit < 0 ? v_exit - v_entry : std::max(v_exit, -v_entry))
-              : (v_entry < 0 || v_exit > 0 ? v_entry - v_exit : std::max(-v_exit, v_entry));
-      if (jerk > L.jerk_[k]) factor *= L.jerk_[k] / jerk, limited = true;
-    }
-    if (limited) junction *= factor;
-    const double threshold = junction * 0.99;
-    if (prev.safe > threshold && safe > threshold) junction = safe;
+  double safe = 0, junction = 0;  // with junction deviation a block may always stop at rest
+  const bool after_motion = !first && prev.feed > 1e-4;
+  if (L.deviation_ > 0) {
+    if (after_motion) junction = deviation_junction(unit, v, a, d, L.accel_, L.deviation_, prev);
+  } else {
+    safe = v;
+    for (int k = 0; k < 4; ++k)
+      if (std::abs(axis[k]) > L.jerk_[k]) safe = std::min(safe, L.jerk_[k]);
+    junction = after_motion ? jerk_junction(axis, v, safe, L.jerk_, prev) : safe;
   }
   const double allowable = max_allowable(-a, safe, d);
   b.d = d, b.a = a, b.cruise = v, b.safe = safe;
   b.entry = std::min(junction, allowable);
   b.max_entry = junction;
   b.nominal_length = v <= allowable;
-  prev.feed = v, prev.safe = safe, prev.axis = axis;
+  prev.feed = v, prev.safe = safe, prev.axis = axis, prev.unit = unit;
   return true;
 }
 

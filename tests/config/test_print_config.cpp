@@ -135,9 +135,10 @@ TEST(Config, EverySettingHasARange) {
 // effect, and a bad value is refused naming the key.
 TEST(Config, MachineLimitsAreSettingsTheEstimateReads) {
   PrintConfig c;
-  for (const char* key : {"machine_max_acceleration_extruding", "machine_max_jerk_x",
-                          "machine_max_feedrate_e", "machine_min_travel_rate", "silent_mode",
-                          "remaining_times", "filament_density", "filament_cost"}) {
+  for (const char* key :
+       {"machine_max_acceleration_extruding", "machine_max_jerk_x", "machine_max_feedrate_e",
+        "machine_min_travel_rate", "silent_mode", "remaining_times", "filament_density",
+        "filament_cost", "machine_max_junction_deviation"}) {
     auto r = set_config_value(c, key, "1");
     ASSERT_TRUE(r) << key;
     EXPECT_TRUE(*r) << key;
@@ -145,6 +146,9 @@ TEST(Config, MachineLimitsAreSettingsTheEstimateReads) {
   ASSERT_TRUE(set_config_value(c, "machine_max_acceleration_extruding", "500,960"));
   EXPECT_EQ(machine_limits(c).accel_extruding, 500);
   EXPECT_EQ(machine_limits(c, 1).accel_extruding, 960);
+  ASSERT_TRUE(set_config_value(c, "machine_max_junction_deviation", "0.013,0.02"));
+  EXPECT_EQ(machine_limits(c).junction_deviation, 0.013);
+  EXPECT_EQ(machine_limits(c, 1).junction_deviation, 0.02);
   auto bad = set_config_value(c, "machine_max_jerk_y", "8,fast");
   ASSERT_FALSE(bad);
   EXPECT_NE(bad.error().message.find("machine_max_jerk_y: 'fast' is not a number"),

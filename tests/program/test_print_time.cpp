@@ -62,6 +62,58 @@ TEST(PrintTime, JunctionsKeepSpeedWhereJerkAllows) {
   EXPECT_EQ(format_duration(45), "45s");
 }
 
+// Marlin 2's junction deviation δ (#16): a corner of angle θ between two directions is
+// driven at v² = a δ sin(θ/2) / (1 − sin(θ/2)) instead of the jerk limits.
+TEST(PrintTime, JunctionDeviationSetsTheCornerSpeed) {
+  MachineLimits m = no_jerk();
+  m.accel_travel = 1000;
+  m.junction_deviation = 0.05;
+  // Two 50 mm moves at 50 mm/s, square to each other: accelerate from rest, cruise, slow to
+  // the corner's speed, and the mirror image after it.
+  const double a = 1000, v = 50, s = std::sqrt(0.5);
+  const double vj = std::sqrt(a * 0.05 * s / (1 - s));  // 10.99 mm/s
+  const double one =
+      v / a + (v - vj) / a + (50 - v * v / (2 * a) - (v * v - vj * vj) / (2 * a)) / v;
+  const std::string corner = "G1 X50 F3000\nG1 X50 Y50\n";
+  EXPECT_NEAR(seconds(corner, m), 2 * one, 1e-9);
+  // The same δ from the file's M205 J, the profile's being 0.
+  MachineLimits from_file = m;
+  from_file.junction_deviation = 0;
+  EXPECT_NEAR(seconds("M205 J0.05\n" + corner, from_file), 2 * one, 1e-9);
+  // Jerk no longer matters once δ is set; a straight joint keeps full speed; a reversal stops.
+  MachineLimits jerky = m;
+  jerky.jerk_x = jerky.jerk_y = 100;
+  EXPECT_NEAR(seconds(corner, jerky), 2 * one, 1e-9);
+  EXPECT_NEAR(seconds("G1 X50 F3000\nG1 X100\n", m), seconds("G1 X100 F3000\n", m), 1e-9);
+  EXPECT_NEAR(seconds("G1 X50 F3000\nG1 X0\n", m), 2 * seconds("G1 X50 F3000\n", m), 1e-9);
+  // A larger δ takes the corner faster.
+  MachineLimits loose = m;
+  loose.junction_deviation = 0.2;
+  EXPECT_LT(seconds(corner, loose), seconds(corner, m) - 0.01);
+}
+
+TEST(PrintTime, ShortMovesAtAGentleTurnAreDrivenAsAnArc) {
+  // Two 0.5 mm moves turning 44°, a δ so large it limits nothing: the firmware drives such a
+  // turn as an arc through the move's length, v² ≤ d a / θ (θ by its acos, within 0.033 rad).
+  // Each move is then a triangle from rest up and down to that speed (and back).
+  MachineLimits m = no_jerk();
+  m.accel_travel = 1000;
+  m.junction_deviation = 50;
+  const double a = 1000, d = 0.5, turn = 44 * M_PI / 180;
+  char buf[128];
+  std::snprintf(buf, sizeof buf, "G1 X0.5 F3000\nG1 X%.9f Y%.9f\n", d + d * std::cos(turn),
+                d * std::sin(turn));
+  auto pair_time = [&](double vj2) {  // rest → peak → √vj2, twice
+    const double up = (2 * a * d + vj2) / (4 * a), peak = std::sqrt(2 * a * up);
+    return 2 * (peak / a + (peak - std::sqrt(vj2)) / a);
+  };
+  const double t = seconds(buf, m);
+  EXPECT_GT(t, pair_time(d * a / (turn - 0.033)) - 1e-9);  // a smaller θ: a faster turn
+  EXPECT_LT(t, pair_time(d * a / (turn + 0.033)) + 1e-9);
+  // Without the arc the junction would be as fast as the moves allow (v² = 2 a d).
+  EXPECT_GT(t, pair_time(2 * a * d) + 4e-4);
+}
+
 TEST(PrintStats, FooterAndProgressAreRecomputedInPlace) {
   PrintConfig c;
   c.profile["remaining_times"] = "1";
