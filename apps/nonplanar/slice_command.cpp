@@ -127,16 +127,19 @@ int run(const SliceOptions& o) {
   if (loaded->objects.several()) {
     // A 3MF's build items, where it placed them: each layer prints them one by one, each
     // with its own label. Another slicer gets the normalised part as one object, and so does
-    // a plate of more than 256 objects (each path looks at every object's box).
-    constexpr std::size_t kMostObjects = 256;
-    if (job.engine.engine == Engine::builtin && loaded->objects.items.size() <= kMostObjects) {
-      cfg.gcode.objects = job.print.gcode.objects = loaded->objects.items;
+    // a plate of more objects than the library prints apart.
+    if (job.engine.engine == Engine::builtin)
       job.objects = object_outlines(loaded->mesh, loaded->objects);
+    const std::size_t n = loaded->objects.items.size();
+    if (!job.objects.empty()) {
+      cfg.gcode.objects = job.print.gcode.objects = loaded->objects.items;
     } else if (!o.mesh.quiet) {
+      const std::string why = job.engine.engine != Engine::builtin ? " through " + o.engine
+                              : n > kMostPlateObjects
+                                  ? " (more than " + std::to_string(kMostPlateObjects) + ")"
+                                  : "";
       std::fprintf(stderr, "notice: %s: its %zu objects print as one object%s\n",
-                   o.mesh.model.c_str(), loaded->objects.items.size(),
-                   job.engine.engine == Engine::builtin ? " (more than 256)"
-                                                        : (" through " + o.engine).c_str());
+                   o.mesh.model.c_str(), n, why.c_str());
     }
   }
   auto result = slice_model(loaded->mesh, job, ctx);

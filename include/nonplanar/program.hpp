@@ -121,6 +121,13 @@ GcodeProgram read_gcode_program(std::string_view text);
 GcodeProgram for_each_gcode_line(std::string_view text,
                                  const std::function<void(const GcodeLine&, const GcodeMove*)>& f);
 
+/// How many lines a text has, and how many of them start with a G (an upper bound of the
+/// moves any reading of it finds): room to reserve before reading it, once.
+struct GcodeLineCount {
+  std::size_t lines = 0, g_lines = 0;
+};
+GcodeLineCount count_gcode_lines(std::string_view text);
+
 /// One G0/G1 move with what it deposited (check's input).
 struct PrintMove {
   Vec3 from{0, 0, 0}, to{0, 0, 0};
@@ -163,8 +170,12 @@ struct ObjectOutline {
   bool covers(const Vec2& p) const;
 };
 
+/// The most objects a plate prints apart: each path looks at every object's box.
+inline constexpr std::size_t kMostPlateObjects = 256;
+
 /// One outline per object of `objects` (objects.face: an index per face of `mesh`); none when
-/// the plate holds one object. Rasters of 0.2 mm cells (coarser past 4 million a raster).
+/// the plate holds one object, or more than kMostPlateObjects (it then prints as one object).
+/// Rasters of 0.2 mm cells (coarser past 4 million a raster).
 std::vector<ObjectOutline> object_outlines(const TriangleMesh& mesh, const PlateObjects& objects);
 
 /// The object a point prints: the one whose footprint holds it in XY, among those whose box

@@ -54,14 +54,18 @@ std::string ObjectLabels::define(const std::vector<LayerToolpaths>& layers) cons
           const auto k = static_cast<std::size_t>(p.object);
           min[k] = min[k].cwiseMin(q.head<2>()), max[k] = max[k].cwiseMax(q.head<2>());
         }
-  std::string s;
+  auto printed = [&](std::size_t k) { return min[k].x() <= max[k].x(); };
   char buf[600];
+  if (!klipper) {  // M486 counts the objects; it names none
+    bool any = false;
+    for (std::size_t k = 0; k < n; ++k) any |= printed(k);
+    if (!any) return "";
+    std::snprintf(buf, sizeof buf, "M486 T%zu\n", n);
+    return buf;
+  }
+  std::string s;
   for (std::size_t k = 0; k < n; ++k) {
-    if (min[k].x() > max[k].x()) continue;
-    if (!klipper) {
-      std::snprintf(buf, sizeof buf, "M486 T%zu\n", n);
-      return buf;
-    }
+    if (!printed(k)) continue;
     std::snprintf(buf, sizeof buf,
                   "EXCLUDE_OBJECT_DEFINE NAME=%s CENTER=%.3f,%.3f POLYGON=[[%.3f,%.3f],[%.3f,%.3f],"
                   "[%.3f,%.3f],[%.3f,%.3f]]\n",

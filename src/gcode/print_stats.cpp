@@ -102,11 +102,9 @@ std::string with_print_stats(std::string_view gcode, const PrintConfig& c, Print
   // mode": its own estimate and progress) and the net E of every move.
   const bool silent = silent_mode_estimate(c);
   PrintTimer normal(machine_limits(c)), stealth(machine_limits(c, silent ? 1 : 0));
-  std::size_t lines = 1, moves = 0;  // at most
-  for (std::size_t k = 0; k < gcode.size(); ++k)
-    if (gcode[k] == '\n') ++lines, moves += k + 1 < gcode.size() && (gcode[k + 1] | 0x20) == 'g';
-  normal.reserve(lines, moves + 1);
-  if (silent) stealth.reserve(lines, moves + 1);
+  const GcodeLineCount n = count_gcode_lines(gcode);  // and one entry more: the total
+  normal.reserve(n.lines + 1, n.g_lines);
+  if (silent) stealth.reserve(n.lines + 1, n.g_lines);
   double filament = 0;  // net: a retraction and its restore cancel
   const GcodeProgram program =
       for_each_gcode_line(gcode, [&](const GcodeLine& l, const GcodeMove* m) {

@@ -54,7 +54,9 @@ bool ObjectOutline::covers(const Vec2& p) const {
 }
 
 std::vector<ObjectOutline> object_outlines(const TriangleMesh& mesh, const PlateObjects& objects) {
-  if (!objects.several() || objects.face.size() != mesh.faces.size()) return {};
+  if (!objects.several() || objects.items.size() > kMostPlateObjects ||
+      objects.face.size() != mesh.faces.size())
+    return {};
   std::vector<ObjectOutline> out(objects.items.size());
   for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
     const auto k = static_cast<std::size_t>(objects.face[f]);

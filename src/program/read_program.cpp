@@ -97,7 +97,6 @@ class Reader {
   const LineSink* line_sink_;
   GcodeMove last_;     // with line_sink_: the move of the line being read
   std::size_t n_ = 0;  // lines in the file
-  std::size_t g_ = 0;  // lines that start with a G: room for the moves, reserved once
   int line_ = 0;
   Vec3 pos_{0, 0, 0};
   GcodeState s_;
@@ -109,11 +108,13 @@ class Reader {
 };
 
 void Reader::run(std::string_view text) {
+  const GcodeLineCount n = count_gcode_lines(text);
+  n_ = n.lines;
   find_print(text);
   // Reserved: grown by doubling, the bunny's 700 000 lines were copied over and over, and the
   // pages of each new block faulted in (a third of the reading).
   const bool keep = !sink_ && !line_sink_;
-  if (keep) p_.lines.reserve(n_), p_.moves.reserve(g_);
+  if (keep) p_.lines.reserve(n.lines), p_.moves.reserve(n.g_lines);
   for_each_line(text, [&](std::size_t i, std::string_view l) {
     GcodeLine item;
     item.raw = l;
@@ -127,8 +128,6 @@ void Reader::find_print(std::string_view text) {
   std::size_t last_typed = 0, begin = std::string_view::npos;
   std::vector<std::size_t> custom;  // the ;TYPE:Custom lines
   for_each_line(text, [&](std::size_t i, std::string_view l) {
-    n_ = i + 1;
-    g_ += !l.empty() && upper(l[0]) == 'G';
     if (begin == std::string_view::npos && l.rfind(";LAYER_CHANGE", 0) == 0) begin = i;
     if (l.rfind(";TYPE:Custom", 0) == 0)
       custom.push_back(i);
@@ -341,14 +340,22 @@ namespace {
 // gate peaked at 163 MB so, for 72 MB of moves), and the room no move takes is never touched,
 // so it costs address space, not memory.
 std::vector<PrintMove> room_for_moves(std::string_view text) {
-  std::size_t g = 1;
-  for (std::size_t k = 0; k < text.size(); ++k)
-    g += text[k] == '\n' && k + 1 < text.size() && (text[k + 1] | 0x20) == 'g';
   std::vector<PrintMove> moves;
-  reserve_huge(moves, g);
+  reserve_huge(moves, count_gcode_lines(text).g_lines);
   return moves;
 }
 }  // namespace
+
+GcodeLineCount count_gcode_lines(std::string_view text) {
+  // As for_each_line splits: a last line without its line end counts, an empty end does not.
+  GcodeLineCount n;
+  bool at_start = true;
+  for (const char c : text) {
+    if (at_start) ++n.lines, n.g_lines += (c | 0x20) == 'g';
+    at_start = c == '\n';
+  }
+  return n;
+}
 
 std::vector<PrintMove> read_print_moves(std::string_view text,
                                         const std::function<bool(const GcodeMove&)>& keep) {
