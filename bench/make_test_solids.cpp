@@ -25,7 +25,8 @@ int main(int argc, char** argv) {
       {"rib.stl", t::rib()},
       {"rib_beside_tower.stl", t::rib_beside_tower()},
       {"hollow_roof_1.5mm.stl", t::hollow_roof(1.5)},
-      {"hollow_roof_0.8mm.stl", t::hollow_roof(0.8)}};
+      {"hollow_roof_0.8mm.stl", t::hollow_roof(0.8)},
+      {"two_reliefs.stl", t::two_reliefs()}};
   for (const auto& [name, mesh] : solids) {
     auto w = nonplanar::write_stl(dir / name, mesh);
     if (!w) {

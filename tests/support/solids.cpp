@@ -164,6 +164,15 @@ TriangleMesh rib_against_tower() {
   return m;
 }
 
+TriangleMesh two_reliefs() {
+  auto top = [](double x, double y) {
+    if (x < 25) return 4 + 3 * std::sin(2 * M_PI * x / 25) * std::cos(y / 8);
+    if (x < 45) return 2.0;
+    return 10 + 3 * std::cos(2 * M_PI * (x - 45) / 25) * std::cos(y / 8);
+  };
+  return height_field_solid(top, 0, 70, 0, 30, 280, 60);
+}
+
 TriangleMesh hollow_roof(double wall) {
   auto roof = [](double x, double y) { return 6 + 2.5 * std::sin(x / 7) * std::cos(y / 9); };
   TriangleMesh m = height_field_solid(roof, 0, 40, 0, 40, 80, 80);

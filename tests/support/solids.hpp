@@ -57,6 +57,12 @@ TriangleMesh rib_against_tower();
 /// (the part is not solid under its top); a shell must rest on the wall's top alone.
 TriangleMesh hollow_roof(double wall);
 
+/// two reliefs: 70 × 30 mm, two curved tops too tall for a stack over a plane, apart by a
+/// 20 mm plate 2 mm thick: at x < 25 the top is 4 + 3 sin(2πx / 25) cos(y / 8), at x ≥ 45 it is
+/// 10 + 3 cos(2π(x − 45) / 25) cos(y / 8). Each gets its own shell (the multi-shell path the
+/// shared bunny takes, at a thousandth of its cost).
+TriangleMesh two_reliefs();
+
 /// The shared test models folder (../shared/models beside the repo); empty if absent.
 std::filesystem::path shared_models();
 
