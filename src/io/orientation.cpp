@@ -56,6 +56,28 @@ std::size_t orient_outward(TriangleMesh& mesh, const MeshTopology& topo, bool* i
     vol[c] += a.dot(b.cross(d)) / 6.0;
     for (int k = 0; k < 3; ++k) box[c].extend(mesh.vertices[t[k]]);
   }
+  // An open piece's volume about any one point says nothing of its winding (a correctly wound
+  // teapot lid read as inside out about its knob's tip). Close each open piece with a fan of
+  // triangles from its boundary's centroid over every open edge, and judge the closed volume.
+  std::vector<Vec3> rim_sum(ncomp, Vec3::Zero());
+  std::vector<std::size_t> rim_count(ncomp, 0);
+  auto for_each_open_edge = [&](auto&& f) {  // f(component, from, to): the edge as wound now
+    for (std::size_t face = 0; face < nf; ++face)
+      for (int k = 0; k < 3; ++k) {
+        if (topo.across[3 * face + k] != MeshTopology::kOpen) continue;
+        auto t = mesh.faces[face];
+        if (flipped[face]) flip(t);  // back to the corner order the topology counts in
+        int from = t[k], to = t[(k + 1) % 3];
+        if (flipped[face]) std::swap(from, to);
+        f(comp[face], mesh.vertices[from], mesh.vertices[to]);
+      }
+  };
+  for_each_open_edge(
+      [&](int c, const Vec3& from, const Vec3&) { rim_sum[c] += from, ++rim_count[c]; });
+  for_each_open_edge([&](int c, const Vec3& from, const Vec3& to) {
+    const Vec3 centre = rim_sum[c] / static_cast<double>(rim_count[c]) - origin[c];
+    vol[c] += centre.dot((to - origin[c]).cross(from - origin[c])) / 6.0;
+  });
   auto inside = [&](int a, int b) {  // bbox of a strictly inside bbox of b
     return (box[a].min.array() > box[b].min.array()).all() &&
            (box[a].max.array() < box[b].max.array()).all();
