@@ -33,8 +33,9 @@ struct PrintTime {
 
 /// Every G0/G1 becomes a block with Marlin's trapezoid: entry speeds bounded by the jerk
 /// limits (or the junction deviation) at each junction, then a backward and a forward pass
-/// over the whole program so each block can reach its neighbours' speeds within its
-/// acceleration.
+/// over the blocks queued so each block can reach its neighbours' speeds within its
+/// acceleration. As in PrusaSlicer's estimate, once 256 blocks are queued all but the last 64
+/// are timed for good.
 PrintTime estimate_print_time(const GcodeProgram& program, const MachineLimits& limits);
 
 /// The same estimate fed one line at a time, so a large file need not be held read (a
@@ -45,9 +46,9 @@ class PrintTimer {
   ~PrintTimer();
   PrintTimer(const PrintTimer&) = delete;
   PrintTimer& operator=(const PrintTimer&) = delete;
-  /// Room for this many lines and moves (grown by doubling, the bunny's 64-byte blocks peaked
-  /// at 100 MB).
-  void reserve(std::size_t lines, std::size_t moves);
+  /// Room for this many lines, and one more (grown by doubling, the per-line times were
+  /// copied over and over). The moves wait in a queue of at most 257 blocks.
+  void reserve(std::size_t lines);
   /// The program's next line, with its move when it is a G0/G1 (else null).
   void line(const GcodeLine& l, const GcodeMove* move);
   /// The estimate of the lines given (line_start: one entry per line, and the total). Once:

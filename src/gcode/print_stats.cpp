@@ -103,8 +103,8 @@ std::string with_print_stats(std::string_view gcode, const PrintConfig& c, Print
   const bool silent = silent_mode_estimate(c);
   PrintTimer normal(machine_limits(c)), stealth(machine_limits(c, silent ? 1 : 0));
   const GcodeLineCount n = count_gcode_lines(gcode);  // and one entry more: the total
-  normal.reserve(n.lines + 1, n.g_lines);
-  if (silent) stealth.reserve(n.lines + 1, n.g_lines);
+  normal.reserve(n.lines + 1);
+  if (silent) stealth.reserve(n.lines + 1);
   double filament = 0;  // net: a retraction and its restore cancel
   const GcodeProgram program =
       for_each_gcode_line(gcode, [&](const GcodeLine& l, const GcodeMove* m) {

@@ -1,6 +1,5 @@
 // The time estimate of print_time.hpp: PrusaSlicer's GCodeProcessor planner (itself Marlin's
-// planner: classic jerk, or Marlin 2's junction deviation), with the whole program as its
-// look-ahead instead of 64 blocks.
+// planner: classic jerk, or Marlin 2's junction deviation), with its queue of blocks.
 // Notation: v speeds (mm/s), a acceleration (mm/s²), d a block's length (mm); axes X Y Z E;
 // δ the junction deviation (mm), θ the angle between two moves' directions.
 #include "nonplanar/print_time.hpp"
@@ -242,20 +241,38 @@ double dwell(std::string_view raw) {
 
 }  // namespace
 
+// The planner's queue, as PrusaSlicer's GCodeProcessor keeps it after the firmware: once
+// 256 blocks wait, all but the last 64 are planned and timed for good. A block's time then no
+// longer waits for the whole file (the bunny's blocks took 67 MB), and the estimate is
+// PrusaSlicer's, whose look-ahead ends there too.
+constexpr std::size_t kQueue = 64, kRefresh = 4 * kQueue;
+
 struct PrintTimer::Impl {
   explicit Impl(const MachineLimits& m) : L(m) {}
   Limits L;
   Previous prev;
-  std::vector<Block> blocks;
-  std::vector<double> extra;  // per line: its dwell
+  bool moved = false;         // a block was made (the first starts at rest)
+  std::vector<Block> blocks;  // the queue
+  std::vector<double> extra;  // per line: its dwell, and the time of the blocks done on it
+  // Plans the queue and times all but its last `keep` blocks, which stay queued.
+  void settle(std::size_t keep) {
+    plan(blocks);
+    const std::size_t done = blocks.size() - std::min(keep, blocks.size());
+    for (std::size_t k = 0; k < done; ++k) {
+      const double exit = k + 1 < blocks.size() ? blocks[k + 1].entry : blocks[k].safe;
+      extra[blocks[k].line] += blocks[k].time(exit);
+    }
+    blocks.erase(blocks.begin(), blocks.begin() + static_cast<std::ptrdiff_t>(done));
+  }
 };
 
-PrintTimer::PrintTimer(const MachineLimits& limits) : impl_(std::make_unique<Impl>(limits)) {}
+PrintTimer::PrintTimer(const MachineLimits& limits) : impl_(std::make_unique<Impl>(limits)) {
+  impl_->blocks.reserve(kRefresh + 1);
+}
 PrintTimer::~PrintTimer() = default;
 
-void PrintTimer::reserve(std::size_t lines, std::size_t moves) {
+void PrintTimer::reserve(std::size_t lines) {
   reserve_huge(impl_->extra, lines);
-  reserve_huge(impl_->blocks, moves);
 }
 
 void PrintTimer::line(const GcodeLine& l, const GcodeMove* move) {
@@ -264,7 +281,10 @@ void PrintTimer::line(const GcodeLine& l, const GcodeMove* move) {
   s.extra.push_back(0.0);
   if (l.kind == GcodeLine::Kind::move && move) {
     Block b;
-    if (make_block(*move, s.L, s.prev, s.blocks.empty(), b)) b.line = i, s.blocks.push_back(b);
+    if (make_block(*move, s.L, s.prev, !s.moved, b)) {
+      b.line = i, s.blocks.push_back(b), s.moved = true;
+      if (s.blocks.size() > kRefresh) s.settle(kQueue);
+    }
   } else if (l.kind == GcodeLine::Kind::text && !l.raw.empty()) {
     s.L.read(l.raw);
     s.extra[i] = dwell(l.raw);
@@ -273,16 +293,9 @@ void PrintTimer::line(const GcodeLine& l, const GcodeMove* move) {
 
 PrintTime PrintTimer::finish() {
   Impl& s = *impl_;
-  std::vector<Block>& blocks = s.blocks;
-  plan(blocks);
-  std::vector<double>& spent = s.extra;  // dwells, and now each line's moves too
-  for (std::size_t k = 0; k < blocks.size(); ++k) {
-    const double exit = k + 1 < blocks.size() ? blocks[k + 1].entry : blocks[k].safe;
-    spent[blocks[k].line] += blocks[k].time(exit);
-  }
-  // The blocks go before the caller writes the file anew (the bunny's took 67 MB), and each
-  // line's time becomes its start in place.
-  std::vector<Block>().swap(blocks);
+  s.settle(0);
+  // Each line's time becomes its start, in place.
+  std::vector<double>& spent = s.extra;
   double at = 0;
   for (double& s_i : spent) {
     const double own = s_i;

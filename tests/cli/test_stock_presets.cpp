@@ -139,6 +139,7 @@ TEST(StockPresets, BlocksMatchPrusaSlicersOwnExpansion) {
     const double our_time = nlohmann::json::parse(c.out)["print_time_s"].get<double>();
     EXPECT_GT(ps_time, 60);
     EXPECT_NEAR(our_time / ps_time, 1.0, 0.03) << our_time << " s against " << ps_time << " s";
+    std::printf("%s normal: ours %.0f s, PrusaSlicer %.0f s\n", s.printer, our_time, ps_time);
     // The MK3S's stealth mode too, where PrusaSlicer estimates one.
     const double ps_silent = estimate_in(test::read_bytes(theirs), "silent");
     const auto j = nlohmann::json::parse(c.out);

@@ -187,6 +187,17 @@ TEST(PrintStats, SilentModeHasItsOwnEstimateAndProgress) {
 
 // with_print_stats reads a file line by line (for_each_gcode_line into a PrintTimer) instead
 // of holding it read: every line's start time must be the whole program's, to the bit.
+// #20: past 256 queued blocks all but the last 64 are timed for good, as PrusaSlicer's
+// estimate does. 64 blocks of 0.1 mm are room enough to slow down in, so 1000 collinear
+// moves still take what one move of their length takes.
+TEST(PrintTime, AQueueOf64BlocksKeepsALongRunAtFullSpeed) {
+  MachineLimits m;  // jerk 10 mm/s: the first move starts at 10, the last ends at 10
+  m.accel_travel = 1000;
+  std::string many = "G1 X0.1 F3000\n";
+  for (int k = 2; k <= 1000; ++k) many += "G1 X" + std::to_string(k * 0.1) + "\n";
+  EXPECT_NEAR(seconds(many, m), seconds("G1 X100 F3000\n", m), 1e-9);
+}
+
 TEST(PrintTime, StreamedLineByLineIsTheWholeProgramsEstimate) {
   std::string in = "M201 X900 Y900\nM204 S800 T1200\nG90\nM83\nG92 E0\n";
   for (int k = 0; k < 200; ++k) {
