@@ -75,6 +75,15 @@ Expected<CollisionFigures> find_collisions(const std::vector<PrintMove>& moves,
                                            const std::function<bool(const Vec3&)>& looked_at,
                                            const Context& ctx);
 
+/// Moves played in order, as often as asked: each call calls its argument once per move.
+using MoveReplay = std::function<void(const std::function<void(const PrintMove&)>&)>;
+
+/// The same search over moves replayed twice rather than held (the gate reads them from its
+/// text each time: on the bunny a vector of them was 110 MB).
+Expected<CollisionFigures> find_collisions(const MoveReplay& moves, const CheckParams& params,
+                                           const std::function<bool(const Vec3&)>& looked_at,
+                                           const Context& ctx);
+
 /// Computes the figures; `mesh` (placed like the G-code) may be null, then deviation,
 /// volume ratio and outside fraction are left at 0. Errors: cancelled.
 Expected<CheckFigures> check_print(const std::vector<PrintMove>& moves, const TriangleMesh* mesh,

@@ -144,6 +144,11 @@ struct PrintMove {
 std::vector<GcodeProblem> for_each_gcode_move(std::string_view text,
                                               const std::function<void(const GcodeMove&)>& f);
 
+/// The moves of a file as check reads them, one at a time to f, among those `keep` accepts
+/// (null: all). Problems are not looked at (for a file this program wrote or mapped itself).
+void for_each_print_move(std::string_view text, const std::function<bool(const GcodeMove&)>& keep,
+                         const std::function<void(const PrintMove&)>& f);
+
 /// The moves of a file as check reads them; with `keep`, only those it accepts. Problems are
 /// not looked at (for a file this program wrote or mapped itself).
 std::vector<PrintMove> read_print_moves(

@@ -325,12 +325,24 @@ struct Samples {
   double filament = 0;
   std::size_t extrusions = 0;
   double steepest_deg = 0;
+  double z_lo = 1e300, z_hi = -1e300;  // of every extrusion inside the print, the skirt's too
 };
 
-Expected<Samples> sample_extrusions(const std::vector<PrintMove>& moves) {
+// Replays a vector of moves.
+MoveReplay replay(const std::vector<PrintMove>& moves) {
+  return [&moves](const std::function<void(const PrintMove&)>& f) {
+    for (const PrintMove& m : moves) f(m);
+  };
+}
+
+Expected<Samples> sample_extrusions(const MoveReplay& moves) {
   Samples s;
-  for (const PrintMove& m : moves) {
-    if (!counts(m)) continue;
+  std::optional<Error> error;
+  moves([&](const PrintMove& m) {
+    if (error || !m.extruding || m.layer < 0) return;
+    s.z_lo = std::min({s.z_lo, m.from.z(), m.to.z()});
+    s.z_hi = std::max({s.z_hi, m.from.z(), m.to.z()});
+    if (!counts(m)) return;
     s.filament += m.filament;
     const double len = (m.to - m.from).norm();
     const int n = std::max(1, static_cast<int>(std::ceil(len / 0.2)));
@@ -344,14 +356,16 @@ Expected<Samples> sample_extrusions(const std::vector<PrintMove>& moves) {
                     "line %d: extrusions span %.0f x %.0f mm; check measures prints up to %.0f mm "
                     "across (a move far off the bed?)",
                     m.line, s.hi.x() - s.lo.x(), s.hi.y() - s.lo.y(), kMaxSpan);
-      return Error{Status::invalid_argument, buf};
+      error = Error{Status::invalid_argument, buf};
+      return;
     }
     s.extrusions += static_cast<std::size_t>(n);
     const double dxy = (m.to.head<2>() - m.from.head<2>()).norm();
     if (dxy > 0.05)
       s.steepest_deg =
           std::max(s.steepest_deg, std::atan2(std::abs(m.to.z() - m.from.z()), dxy) * 180 / M_PI);
-  }
+  });
+  if (error) return *error;
   return s;
 }
 
@@ -408,24 +422,21 @@ void measure_thickness(const PointGrid& grid, CheckFigures& f) {
 }
 
 // Collisions, in print order, among the points `looked_at` accepts (null: all).
-Expected<CollisionFigures> search_collisions(const std::vector<PrintMove>& moves, const Samples& s,
+Expected<CollisionFigures> search_collisions(const MoveReplay& moves, const Samples& s,
                                              const CheckParams& cp,
                                              const std::function<bool(const Vec3&)>& looked_at,
                                              const Context& ctx) {
   CollisionFigures f;
   // Material stands at most the print's height above the nozzle: higher parts of the head
   // (a gantry) are left out, which keeps the search radius that of the parts that can touch.
-  double z_lo = 1e300, z_hi = -1e300;
-  for (const PrintMove& m : moves)
-    if (m.extruding && m.layer >= 0)
-      z_lo = std::min({z_lo, m.from.z(), m.to.z()}), z_hi = std::max({z_hi, m.from.z(), m.to.z()});
-  const HeadClearance head(cp.toolhead, z_hi - z_lo);
+  const HeadClearance head(cp.toolhead, s.z_hi - s.z_lo);
   const double margin = head.reach() + 1;
   Deposit dep(s.lo - Vec2(margin, margin), s.hi + Vec2(margin, margin), 0.2);
-  for (std::size_t mi = 0; mi < moves.size(); ++mi) {
-    const PrintMove& m = moves[mi];
-    if ((mi & 0xffff) == 0 && ctx.cancelled()) return Error{Status::cancelled, "cancelled"};
-    if (!m.extruding || m.layer < 0) continue;
+  std::size_t mi = 0;
+  bool cancelled = false;
+  moves([&](const PrintMove& m) {
+    if (cancelled || ((mi++ & 0xffff) == 0 && (cancelled = ctx.cancelled()))) return;
+    if (!m.extruding || m.layer < 0) return;
     const double len = (m.to - m.from).norm();
     const int n = std::max(1, static_cast<int>(std::ceil(len / 0.2)));
     for (int k = 1; k <= n; ++k) {
@@ -439,7 +450,8 @@ Expected<CollisionFigures> search_collisions(const std::vector<PrintMove>& moves
       }
       dep.put(p, m.layer);
     }
-  }
+  });
+  if (cancelled) return Error{Status::cancelled, "cancelled"};
   return f;
 }
 
@@ -526,6 +538,12 @@ Expected<CollisionFigures> find_collisions(const std::vector<PrintMove>& moves,
                                            const CheckParams& params,
                                            const std::function<bool(const Vec3&)>& looked_at,
                                            const Context& ctx) {
+  return find_collisions(replay(moves), params, looked_at, ctx);
+}
+
+Expected<CollisionFigures> find_collisions(const MoveReplay& moves, const CheckParams& params,
+                                           const std::function<bool(const Vec3&)>& looked_at,
+                                           const Context& ctx) {
   auto s = sample_extrusions(moves);
   if (!s) return s.error();
   if (s->extrusions == 0) return CollisionFigures{};
@@ -537,7 +555,7 @@ Expected<CollisionFigures> find_collisions(const std::vector<PrintMove>& moves,
 Expected<CheckFigures> check_print(const std::vector<PrintMove>& moves, const TriangleMesh* mesh,
                                    const CheckParams& cp, const Context& ctx) {
   CheckFigures f;
-  auto s = sample_extrusions(moves);
+  auto s = sample_extrusions(replay(moves));
   if (!s) return s.error();
   f.extrusions = s->extrusions, f.steepest_deg = s->steepest_deg;
   if (f.extrusions == 0) return f;
@@ -546,7 +564,7 @@ Expected<CheckFigures> check_print(const std::vector<PrintMove>& moves, const Tr
   measure_thickness(grid, f);
   if (ctx.cancelled()) return Error{Status::cancelled, "cancelled"};
   ctx.progress("check", 0.3);
-  auto c = search_collisions(moves, *s, cp, nullptr, ctx);
+  auto c = search_collisions(replay(moves), *s, cp, nullptr, ctx);
   if (!c) return c.error();
   f.collisions = c->collisions, f.first_collision = c->first_collision;
   f.first_collision_line = c->first_collision_line, f.collision_points = std::move(c->points);

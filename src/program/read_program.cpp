@@ -357,6 +357,13 @@ GcodeLineCount count_gcode_lines(std::string_view text) {
   return n;
 }
 
+void for_each_print_move(std::string_view text, const std::function<bool(const GcodeMove&)>& keep,
+                         const std::function<void(const PrintMove&)>& f) {
+  for_each_gcode_move(text, [&](const GcodeMove& g) {
+    if (!keep || keep(g)) f(print_move(g));
+  });
+}
+
 std::vector<PrintMove> read_print_moves(std::string_view text,
                                         const std::function<bool(const GcodeMove&)>& keep) {
   std::vector<PrintMove> moves = room_for_moves(text);
