@@ -220,9 +220,12 @@ void describe_shells(const std::vector<layers::ShellPlan>& shells, const std::st
 // Curved shells over a planar core (layers/shell_plan.hpp) for a part no stack serves, or
 // serves little, if the gate passes them. Empty when a shell is refused or breaks a limit (a
 // notice then says why).
+// `spent` is called once the shells are sliced, before the gate: their rasters are no longer
+// needed then, unless the caller retries with one of them.
 Expected<std::optional<SliceResult>> try_shell(const TriangleMesh& mesh, const SliceJob& job,
                                                const std::vector<layers::ShellPlan>& shells,
                                                const std::string& why_shell, SliceResult& planar,
+                                               const std::function<void()>& spent,
                                                const Context& ctx) {
   const std::vector<int> patches = shell_patches(shells);
   if (patches.empty()) return std::optional<SliceResult>{};
@@ -248,6 +251,7 @@ Expected<std::optional<SliceResult>> try_shell(const TriangleMesh& mesh, const S
   describe_shells(shells, why_shell, planar, r);
   if (!r.gcode.empty()) r.gcode = engine_header(route, r.header, plan.core.at(1)) + r.gcode;
   r.nonplanar = true;
+  spent();
   std::string breach;
   auto ok = gate(
       r, job, nullptr,
@@ -266,20 +270,32 @@ Expected<std::optional<SliceResult>> try_shell(const TriangleMesh& mesh, const S
   return std::optional<SliceResult>(std::move(r));
 }
 
+// The rasters of a shell sliced and not to be sliced again (on the bunny its four shells'
+// were 80 MB, alive while the gate read the G-code).
+void drop_rasters(layers::ShellPlan& s) {
+  s.top = {}, s.region = {}, s.slack = {}, s.levels = {};
+}
+
 // try_shell over every shell, and when the set is refused, the first alone (nothing orders two
 // shells' points beside each other), if it too covers more than `min_area` mm². why(area): the
-// notice's reason for the shells printed, given their curved area.
+// notice's reason for the shells printed, given their curved area. The plans' rasters go before
+// each gate; a retry plans the first shell again (choose_shells' first is choose_shell's).
 Expected<std::optional<SliceResult>> try_shells(const TriangleMesh& mesh, const SliceJob& job,
                                                 const Analysis& a,
-                                                const std::vector<layers::ShellPlan>& shells,
+                                                std::vector<layers::ShellPlan> shells,
                                                 const std::function<std::string(double)>& why,
                                                 double min_area, SliceResult& planar,
                                                 const Context& ctx) {
-  auto printed = try_shell(mesh, job, shells, why(area_of(a, shell_patches(shells))), planar, ctx);
+  auto spent = [&] {
+    for (layers::ShellPlan& s : shells) drop_rasters(s);
+  };
+  auto printed =
+      try_shell(mesh, job, shells, why(area_of(a, shell_patches(shells))), planar, spent, ctx);
   if (!printed || *printed || shells.size() == 1) return printed;
   const double first = area_of(a, shells.front().patches);
   if (!(first > min_area)) return printed;
-  return try_shell(mesh, job, {shells.front()}, why(first), planar, ctx);
+  shells.assign(1, layers::choose_shell(mesh, a, job.layers));
+  return try_shell(mesh, job, shells, why(first), planar, spent, ctx);
 }
 
 // A part whose stacks follow only a little of its curved top (the CurviSlicer car: 172 mm² of
@@ -294,7 +310,7 @@ Expected<std::optional<SliceResult>> shell_over_stacks(const TriangleMesh& mesh,
                                                        const SliceJob& job, const Analysis& a,
                                                        SliceResult& stacked, const Context& ctx) {
   ctx.progress("shell", 0);
-  const std::vector<layers::ShellPlan> shells = shells_for(mesh, a, job);
+  std::vector<layers::ShellPlan> shells = shells_for(mesh, a, job);
   const double stacks = area_of(a, stacked_patches(stacked.plan));
   if (!shells.front().refused.empty() || !(area_of(a, shell_patches(shells)) > 2 * stacks))
     return std::optional<SliceResult>{};
@@ -304,7 +320,7 @@ Expected<std::optional<SliceResult>> shell_over_stacks(const TriangleMesh& mesh,
                   area, stacks);
     return std::string(buf);
   };
-  return try_shells(mesh, job, a, shells, why, 2 * stacks, stacked, ctx);
+  return try_shells(mesh, job, a, std::move(shells), why, 2 * stacks, stacked, ctx);
 }
 
 }  // namespace
@@ -386,9 +402,8 @@ Expected<SliceResult> slice_rounds(const TriangleMesh& mesh, const SliceJob& job
       // All the patches that need curved layers, taken as one top (the CurviSlicer airfoil's
       // top is two, split at a crease); failing that, the group round the largest, or the
       // largest alone; and a shell per further curved region the part stands above.
-      const std::vector<layers::ShellPlan> plans = shells_for(mesh, pre.analysis, job);
       auto shell = try_shells(
-          mesh, job, pre.analysis, plans,
+          mesh, job, pre.analysis, shells_for(mesh, pre.analysis, job),
           [](double) { return std::string("no stack over a plane fits it"); }, 0, *r, ctx);
       if (!shell) return shell.error();
       if (*shell) return done(std::move(**shell));
