@@ -61,6 +61,21 @@ PrintStats print_stats(const GcodeProgram& program, const PrintConfig& c,
 std::string with_print_stats(std::string_view gcode, const PrintConfig& c,
                              PrintStats* stats = nullptr);
 
+/// with_print_stats in two steps, for a caller that wants the reading done beside other work
+/// and the program changed in place, never held twice (the slicer's gate).
+struct PrintStatsStamp {
+  PrintStats stats;
+  PrintTime normal, stealth;  ///< per-line times (stealth: where silent)
+  bool silent = false, progress = false;
+  std::size_t print_end = 0;  ///< the program's print_end (read_gcode_program)
+  std::string footer;         ///< the footer's lines
+};
+/// Reads `gcode` (the time and filament) and prepares what with_print_stats writes.
+PrintStatsStamp measure_print_stats(std::string_view gcode, const PrintConfig& c);
+/// Writes what `m` measured of this very text into it, in place: the same text as
+/// with_print_stats returns.
+void stamp_print_stats(std::string& gcode, const PrintStatsStamp& m);
+
 /// make_gcode into a file, atomically (temporary file, then rename).
 Expected<void> write_gcode_file(const std::filesystem::path& file,
                                 const std::vector<LayerToolpaths>& layers, const PrintConfig& c,

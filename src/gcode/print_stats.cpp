@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 
 #include "core/huge_pages.hpp"
 #include "core/text_tokens.hpp"
@@ -97,70 +98,72 @@ PrintStats print_stats(const GcodeProgram& program, const PrintConfig& c, PrintT
   return s;
 }
 
-std::string with_print_stats(std::string_view gcode, const PrintConfig& c, PrintStats* stats) {
+PrintStatsStamp measure_print_stats(std::string_view gcode, const PrintConfig& c) {
   // Read once, streamed: the time (and the MK3S's stealth mode's, PrusaSlicer's "silent
   // mode": its own estimate and progress) and the net E of every move.
-  const bool silent = silent_mode_estimate(c);
-  PrintTimer normal(machine_limits(c)), stealth(machine_limits(c, silent ? 1 : 0));
+  PrintStatsStamp m;
+  m.silent = silent_mode_estimate(c);
+  m.progress = first_number(c, "remaining_times").value_or(0) != 0;
+  PrintTimer normal(machine_limits(c)), stealth(machine_limits(c, m.silent ? 1 : 0));
   const GcodeLineCount n = count_gcode_lines(gcode);  // and one entry more: the total
   normal.reserve(n.lines + 1);
-  if (silent) stealth.reserve(n.lines + 1);
+  if (m.silent) stealth.reserve(n.lines + 1);
   double filament = 0;  // net: a retraction and its restore cancel
-  const GcodeProgram program =
-      for_each_gcode_line(gcode, [&](const GcodeLine& l, const GcodeMove* m) {
-        normal.line(l, m);
-        if (silent) stealth.line(l, m);
-        if (m) filament += m->de;
-      });
-  const PrintTime t = normal.finish();
-  const PrintTime ts = silent ? stealth.finish() : PrintTime{};
+  m.print_end = for_each_gcode_line(gcode, [&](const GcodeLine& l, const GcodeMove* mv) {
+                  normal.line(l, mv);
+                  if (m.silent) stealth.line(l, mv);
+                  if (mv) filament += mv->de;
+                }).print_end;
+  m.normal = normal.finish();
+  if (m.silent) m.stealth = stealth.finish();
   filament = std::max(0.0, filament);
   const double d = c.gcode.filament_diameter;
   const double cm3 = filament * M_PI * 0.25 * d * d / 1000.0;
   const double grams = cm3 * first_number(c, "filament_density").value_or(0);
-  if (stats) *stats = PrintStats{t.total, filament, cm3, grams};
-  const auto cost_per_kg = first_number(c, "filament_cost");
-  const bool progress = first_number(c, "remaining_times").value_or(0) != 0;
-  auto progress_at = [&](std::size_t i) {
-    return progress_line(t.line_start[i], t.total) +
-           (silent ? progress_line(ts.line_start[i], ts.total, true) : std::string());
-  };
-
+  m.stats = PrintStats{m.normal.total, filament, cm3, grams};
   char buf[512];
-  std::string block;
   std::snprintf(buf, sizeof buf,
                 "; filament used [mm] = %.2f\n; filament used [cm3] = %.2f\n"
                 "; filament used [g] = %.2f\n",
                 filament, cm3, grams);
-  block += buf;
-  if (cost_per_kg) {
+  m.footer = buf;
+  if (const auto cost_per_kg = first_number(c, "filament_cost")) {
     std::snprintf(buf, sizeof buf, "; filament cost = %.2f\n", grams / 1000.0 * *cost_per_kg);
-    block += buf;
+    m.footer += buf;
   }
-  block += "; estimated printing time (normal mode) = " + format_duration(t.total) + "\n";
-  if (silent)
-    block += "; estimated printing time (silent mode) = " + format_duration(ts.total) + "\n";
+  m.footer += "; estimated printing time (normal mode) = " + format_duration(m.normal.total) + "\n";
+  if (m.silent)
+    m.footer +=
+        "; estimated printing time (silent mode) = " + format_duration(m.stealth.total) + "\n";
+  return m;
+}
 
-  std::string out;
-  out.reserve(gcode.size() + gcode.size() / 50 + block.size());
-  advise_huge_pages(out.data(), out.capacity());
+void stamp_print_stats(std::string& gcode, const PrintStatsStamp& m) {
+  // In place, in two sweeps, so a 40 MB program is never held twice: forward, the lines are
+  // moved down over the dropped ones (old stats lines, CRs), noting where text goes in; then
+  // backward, each stretch moves up by what goes in before it.
+  if (!gcode.empty() && gcode.back() != '\n') gcode += '\n';  // the last line ends too
+  std::vector<std::pair<std::size_t, std::string>> inserts;   // at a place of the moved text
+  std::size_t w = 0;
+  auto progress_at = [&](std::size_t i) {
+    return progress_line(m.normal.line_start[i], m.normal.total) +
+           (m.silent ? progress_line(m.stealth.line_start[i], m.stealth.total, true) : "");
+  };
   bool placed = false, finished = false;
-  if (progress) out += progress_at(0);  // first, as PrusaSlicer writes it
   auto finish = [&] {  // 100 % once the print is done, before the footer at the latest
-    if (!progress || finished) return;
-    out += progress_line(1, 1) + (silent ? progress_line(1, 1, true) : std::string());
+    if (!m.progress || finished) return;
+    inserts.emplace_back(w, progress_line(1, 1) + (m.silent ? progress_line(1, 1, true) : ""));
     finished = true;
   };
   auto place = [&] {
     finish();
-    if (!placed) out += block, placed = true;
+    if (!placed) inserts.emplace_back(w, m.footer), placed = true;
   };
-  // The lines again, as the reader split them (no line ends, a CR dropped).
+  if (m.progress) inserts.emplace_back(0, progress_at(0));  // first, as PrusaSlicer writes it
   std::size_t i = 0;
   for (std::size_t start = 0; start < gcode.size(); ++i) {
-    std::size_t end = gcode.find('\n', start);
-    if (end == std::string_view::npos) end = gcode.size();
-    std::string_view l = gcode.substr(start, end - start);
+    const std::size_t end = gcode.find('\n', start);
+    std::string_view l(gcode.data() + start, end - start);
     start = end + 1;
     if (!l.empty() && l.back() == '\r') l.remove_suffix(1);
     if (l == "; prusaslicer_config = begin") place();
@@ -168,12 +171,34 @@ std::string with_print_stats(std::string_view gcode, const PrintConfig& c, Print
       if (l.rfind("; ", 0) == 0) place();
       continue;
     }
-    if (progress && l == ";LAYER_CHANGE") out += progress_at(i);
-    if (i == program.print_end) finish();
-    out.append(l.data(), l.size());
-    out += '\n';
+    if (m.progress && l == ";LAYER_CHANGE") inserts.emplace_back(w, progress_at(i));
+    if (i == m.print_end) finish();
+    std::memmove(gcode.data() + w, l.data(), l.size());  // never ahead of where it was read
+    w += l.size();
+    gcode[w++] = '\n';
   }
   place();
+  std::size_t grow = 0;
+  for (const auto& ins : inserts) grow += ins.second.size();
+  gcode.resize(w + grow);
+  std::size_t tail = w;  // the moved text from here on is in place already
+  for (std::size_t k = inserts.size(); k-- > 0;) {
+    const auto& [at, text] = inserts[k];
+    grow -= text.size();
+    std::memmove(gcode.data() + at + grow + text.size(), gcode.data() + at, tail - at);
+    std::memcpy(gcode.data() + at + grow, text.data(), text.size());
+    tail = at;
+  }
+}
+
+std::string with_print_stats(std::string_view gcode, const PrintConfig& c, PrintStats* stats) {
+  const PrintStatsStamp m = measure_print_stats(gcode, c);
+  std::string out;
+  out.reserve(gcode.size() + gcode.size() / 50 + m.footer.size() + 1);
+  advise_huge_pages(out.data(), out.capacity());
+  out.assign(gcode);
+  stamp_print_stats(out, m);
+  if (stats) *stats = m.stats;
   return out;
 }
 

@@ -84,13 +84,12 @@ Expected<bool> gate(SliceResult& r, const SliceJob& job, const layers::BandedFie
   // the two agree to the last digit. They are looked for even when bands already broke a
   // limit, so one retry drops every offender (each retry replans, reslices and rechecks).
   if (auto w = write_program(r, job, ctx); !w) return w.error();
-  // The file's time and filament (with_print_stats reads it again), measured on the other core
+  // The file's time and filament (with_print_stats' reading), measured on the other core
   // while this one searches: on the bunny each took about 0.9 s. Kept when this program is
   // the one written (r.stats_in_gcode).
-  std::string stamped;
-  PrintStats stats;
+  PrintStatsStamp stamp;
   core::Background beside;
-  beside.run([&] { stamped = with_print_stats(r.gcode, job.print, &stats); });
+  beside.run([&] { stamp = measure_print_stats(r.gcode, job.print); });
   ctx.progress("collisions", 0);
   // Only where a curved layer is within the head's reach (gate_zones.hpp): on the bunny that
   // skipped most of 24 million extrusion samples. Without bands, only at the heights printed
@@ -119,7 +118,10 @@ Expected<bool> gate(SliceResult& r, const SliceJob& job, const layers::BandedFie
   auto figures = find_collisions(moves, job.check, looked_at, ctx);
   beside.wait();
   if (!figures) return figures.error();
-  r.gcode = std::move(stamped), r.stats = stats, r.stats_in_gcode = true;
+  // In place, once the search no longer reads the text (and its grids are gone): a copy of
+  // the bunny's 37 MB program was alive beside them.
+  stamp_print_stats(r.gcode, stamp);
+  r.stats = stamp.stats, r.stats_in_gcode = true;
   r.collisions = figures->collisions;
   if (figures->collisions > 0)
     for (const Vec3& p : figures->points)

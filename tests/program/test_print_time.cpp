@@ -140,6 +140,14 @@ TEST(PrintStats, FooterAndProgressAreRecomputedInPlace) {
       "; estimated printing time (normal mode) = 4s\n"
       "; prusaslicer_config = begin\n; layer_height = 0.2\n; prusaslicer_config = end\n";
   EXPECT_EQ(out, want);
+  // The same in place (the gate's way: measured, then stamped into the text itself), from
+  // CRLF lines and no line end after the last.
+  std::string crlf;
+  for (char ch : in) ch == '\n' ? void(crlf += "\r\n") : void(crlf += ch);
+  crlf.resize(crlf.size() - 2);
+  std::string stamped = crlf;
+  stamp_print_stats(stamped, measure_print_stats(crlf, c));
+  EXPECT_EQ(stamped, want);
   // Without remaining_times: no M73 at all, the footer still recomputed.
   c.profile.erase("remaining_times");
   const std::string plain = with_print_stats(in, c);
