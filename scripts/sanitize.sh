@@ -30,7 +30,8 @@ cd "$build_dir"
 # Left out here (scripts/test.sh runs them): tests whose time is another program's, PrusaSlicer
 # slicing stock presets and Chromium drawing the preview; the code of ours they run is run
 # under the sanitizers by the engine, shell and preview tests that stay. The bunny's four
-# shells also stay out: they took 92 s here, then 224 s, then over the 300 s test limit.
+# shells also stay out: they took 92 s here, then 224 s, then over the 300 s test limit
+# (NonplanarPrint.TwoReliefsApartGetAShellEach takes the same path of several shells here).
 ctest --output-on-failure -j"$(nproc)" --timeout 1200 \
   -E '^(NonplanarPrint\.SharedBunny|Preview\.TheBrowser|StockPresets\.(CurvedTops|TheWing))'
 

@@ -46,8 +46,9 @@ class PrintTimer {
   ~PrintTimer();
   PrintTimer(const PrintTimer&) = delete;
   PrintTimer& operator=(const PrintTimer&) = delete;
-  /// Room for this many lines, and one more (grown by doubling, the per-line times were
-  /// copied over and over). The moves wait in a queue of at most 257 blocks.
+  /// Room for this many per-line times: one per line, and one for the total (grown by
+  /// doubling, they were copied over and over). The moves wait in a queue of at most 257
+  /// blocks.
   void reserve(std::size_t lines);
   /// The program's next line, with its move when it is a G0/G1 (else null).
   void line(const GcodeLine& l, const GcodeMove* move);

@@ -149,11 +149,6 @@ std::vector<GcodeProblem> for_each_gcode_move(std::string_view text,
 void for_each_print_move(std::string_view text, const std::function<bool(const GcodeMove&)>& keep,
                          const std::function<void(const PrintMove&)>& f);
 
-/// The moves of a file as check reads them; with `keep`, only those it accepts. Problems are
-/// not looked at (for a file this program wrote or mapped itself).
-std::vector<PrintMove> read_print_moves(
-    std::string_view text, const std::function<bool(const GcodeMove&)>& keep = nullptr);
-
 /// The moves of a G-code file, through read_gcode_program (their types view `text`, which
 /// must outlive them). Refused (parse_error naming the
 /// line): any problem but home and probe (arcs, inches, unknown G-codes, junk).

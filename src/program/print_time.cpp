@@ -126,7 +126,7 @@ double jerk_junction(const Axes& axis, double v, double safe, const Axes& jerk,
   return junction;
 }
 
-// acos(t) for t in [0, 1) as Marlin 2 computes it for short sharp junctions: π/2 minus
+// acos(t) for t in [0, 1) as Marlin 2 computes it for short moves at gentle turns: π/2 minus
 // W. R. Franklin's minimax polynomial for asin (error ≤ 0.033 rad; it never returns less
 // than 0.033, which keeps a nearly straight junction's arc limit finite).
 double firmware_acos(double t) {
@@ -140,7 +140,8 @@ double firmware_acos(double t) {
 
 // Marlin 2's junction deviation δ: the corner is driven as an arc that stays within δ of it,
 // at the junction's acceleration a_j: v² = a_j δ sin(θ/2) / (1 − sin(θ/2)), θ the angle between
-// the two directions; a short move at a sharp corner as an arc through its length instead.
+// the two directions; a move under 1 mm turning by less than 45° as an arc through its length
+// instead.
 // Never faster than either move. A full reversal stops.
 double deviation_junction(const Axes& unit, double v, double a, double d, const Axes& accel,
                           double deviation, const Previous& prev) {

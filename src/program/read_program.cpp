@@ -335,17 +335,6 @@ std::vector<GcodeProblem> for_each_gcode_move(std::string_view text,
   return std::move(p.problems);
 }
 
-namespace {
-// Room for every G line of the text: the moves' vector never grows by copying (the bunny's
-// gate peaked at 163 MB so, for 72 MB of moves), and the room no move takes is never touched,
-// so it costs address space, not memory.
-std::vector<PrintMove> room_for_moves(std::string_view text) {
-  std::vector<PrintMove> moves;
-  reserve_huge(moves, count_gcode_lines(text).g_lines);
-  return moves;
-}
-}  // namespace
-
 GcodeLineCount count_gcode_lines(std::string_view text) {
   // As for_each_line splits: a last line without its line end counts, an empty end does not.
   GcodeLineCount n;
@@ -364,17 +353,11 @@ void for_each_print_move(std::string_view text, const std::function<bool(const G
   });
 }
 
-std::vector<PrintMove> read_print_moves(std::string_view text,
-                                        const std::function<bool(const GcodeMove&)>& keep) {
-  std::vector<PrintMove> moves = room_for_moves(text);
-  for_each_gcode_move(text, [&](const GcodeMove& g) {
-    if (!keep || keep(g)) moves.push_back(print_move(g));
-  });
-  return moves;
-}
-
 Expected<std::vector<PrintMove>> read_gcode_moves(std::string_view text) {
-  std::vector<PrintMove> moves = room_for_moves(text);
+  // Room for every G line: the vector never grows by copying, and the room no move takes is
+  // never touched, so it costs address space, not memory.
+  std::vector<PrintMove> moves;
+  reserve_huge(moves, count_gcode_lines(text).g_lines);
   const auto problems =
       for_each_gcode_move(text, [&](const GcodeMove& g) { moves.push_back(print_move(g)); });
   for (const GcodeProblem& q : problems)

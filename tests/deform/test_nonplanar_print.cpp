@@ -325,6 +325,38 @@ TEST(NonplanarPrint, SharedSpikyBlockPrintsAShellOverAllItsFacets) {
   EXPECT_TRUE(all);
 }
 
+// choose_shells' set as slice prints it: the first over the whole part, each further one framed
+// over its own surroundings with a region, all on one core, no patch in two.
+void expect_shells_apart(const std::vector<layers::ShellPlan>& shells) {
+  EXPECT_FALSE(shells[0].framed);
+  for (std::size_t i = 1; i < shells.size(); ++i) {
+    EXPECT_TRUE(shells[i].framed);
+    EXPECT_FALSE(shells[i].region.empty());
+    EXPECT_EQ(shells[i].core, shells[0].core);
+    for (std::size_t j = 0; j < i; ++j)
+      for (int p : shells[i].patches)
+        EXPECT_EQ(std::count(shells[j].patches.begin(), shells[j].patches.end(), p), 0);
+  }
+}
+
+// The print of n shells: no collision, `share` of the curved top within 0.03 mm, the gate's
+// thickness within the limits (check pairs a piece of shell with whatever was printed last
+// below it, which between interleaved pieces can be another piece: 0.094 mm on the bunny),
+// and a notice naming the shells.
+void expect_shells_printed(const Outcome& o, std::size_t n, double share) {
+  EXPECT_EQ(o.figures.collisions, 0u);
+  EXPECT_EQ(o.result.collisions, 0u);
+  EXPECT_GT(o.figures.within_share, share);
+  const LayerParams lp = make_job(PrintConfig{}).layers;
+  EXPECT_GE(o.result.thickness_min, lp.min_layer_height - 1e-3);
+  EXPECT_LE(o.result.thickness_max, lp.max_layer_height + 1e-3);
+  bool named = false;
+  for (const Notice& note : o.result.notices)
+    named |= note.kind == Notice::Kind::shell &&
+             note.text.find(std::to_string(n) + " curved shells") != std::string::npos;
+  EXPECT_TRUE(named);
+}
+
 // The bunny's curved top lies at many heights: its back (112–129 mm), head (151–167 mm),
 // tail and a cheek. One shell over the back alone followed 54 % of it within 0.03 mm; the part
 // stands above that shell (the head), so each further group of patches gets its own shell,
@@ -339,30 +371,10 @@ TEST(NonplanarPrint, SharedBunnyPrintsAShellPerCurvedRegion) {
   const Analysis a = *analyze(mesh, {}, {});
   const std::vector<layers::ShellPlan> shells = layers::choose_shells(mesh, a, make_job(c).layers);
   ASSERT_GE(shells.size(), 3u);
-  EXPECT_FALSE(shells[0].framed);
-  for (std::size_t i = 1; i < shells.size(); ++i) {
-    EXPECT_TRUE(shells[i].framed);
-    EXPECT_FALSE(shells[i].region.empty());
-    EXPECT_EQ(shells[i].core, shells[0].core);
-    for (std::size_t j = 0; j < i; ++j)
-      for (int p : shells[i].patches)
-        EXPECT_EQ(std::count(shells[j].patches.begin(), shells[j].patches.end(), p), 0);
-  }
+  expect_shells_apart(shells);
   CheckParams cp;
   cp.min_angle_deg = 2;
-  const Outcome o = run(m->mesh, c, cp);
-  EXPECT_EQ(o.figures.collisions, 0u);
-  EXPECT_GT(o.figures.within_share, 0.8);
-  // The gate's thickness: check pairs a piece of shell with whatever was printed last below
-  // it, which between interleaved pieces can be another piece (0.094 mm here).
-  const LayerParams lp = make_job(c).layers;
-  EXPECT_GE(o.result.thickness_min, lp.min_layer_height - 1e-3);
-  EXPECT_LE(o.result.thickness_max, lp.max_layer_height + 1e-3);
-  bool several = false;
-  for (const Notice& n : o.result.notices)
-    several |= n.kind == Notice::Kind::shell &&
-               n.text.find(std::to_string(shells.size()) + " curved shells") != std::string::npos;
-  EXPECT_TRUE(several);
+  expect_shells_printed(run(m->mesh, c, cp), shells.size(), 0.8);
 }
 
 // The bunny's path on a small part (it runs under the sanitizers, the bunny does not): two
@@ -374,24 +386,10 @@ TEST(NonplanarPrint, TwoReliefsApartGetAShellEach) {
   const Analysis a = *analyze(mesh, {}, {});
   const std::vector<layers::ShellPlan> shells = layers::choose_shells(mesh, a, make_job(c).layers);
   ASSERT_EQ(shells.size(), 2u);
-  EXPECT_FALSE(shells[0].framed);
-  EXPECT_TRUE(shells[1].framed);
-  EXPECT_EQ(shells[1].core, shells[0].core);
-  for (int p : shells[1].patches)
-    EXPECT_EQ(std::count(shells[0].patches.begin(), shells[0].patches.end(), p), 0);
+  expect_shells_apart(shells);
   CheckParams cp;
   cp.min_angle_deg = 2;
-  const Outcome o = run(test::two_reliefs(), c, cp);
-  EXPECT_EQ(o.figures.collisions, 0u);
-  EXPECT_EQ(o.result.collisions, 0u);
-  EXPECT_GT(o.figures.within_share, 0.85);
-  const LayerParams lp = make_job(c).layers;
-  EXPECT_GE(o.result.thickness_min, lp.min_layer_height - 1e-3);
-  EXPECT_LE(o.result.thickness_max, lp.max_layer_height + 1e-3);
-  bool two = false;
-  for (const Notice& n : o.result.notices)
-    two |= n.kind == Notice::Kind::shell && n.text.find("2 curved shells") != std::string::npos;
-  EXPECT_TRUE(two);
+  expect_shells_printed(run(test::two_reliefs(), c, cp), 2, 0.85);
 }
 
 // At 0.15 mm layers a shell of the profile's layer height put the nozzle tip's flat into
