@@ -43,14 +43,14 @@ const Unsupported* find(const std::string& key) {
 }
 
 // The first item of a per-extruder list ("0,0" or "\"none\""), unquoted.
-std::string first_item(const std::string& v) {
+std::string first_item_unquoted(const std::string& v) {
   std::string s = v.substr(0, v.find_first_of(",;"));
   if (s.size() >= 2 && s.front() == '"' && s.back() == '"') s = s.substr(1, s.size() - 2);
   return s;
 }
 
 bool asks_for_something(const Unsupported& u, const std::string& value) {
-  const std::string v = first_item(value);
+  const std::string v = first_item_unquoted(value);
   if (u.inert == Inert::zero) return !v.empty() && std::strtod(v.c_str(), nullptr) != 0;
   const std::string off = std::string("|") + u.off + "|";
   return off.find("|" + v + "|") == std::string::npos;

@@ -17,12 +17,6 @@ constexpr double kMargin = 0.01;  ///< m: the stairs' thickness stays this far i
 /// downhill side of a tilted bore under a tilted ring, not an overhang the shell would rest on.
 constexpr double kSelfSupporting = 0.7071;
 
-std::string at(const char* what, const Vec3& p) {
-  char buf[200];
-  std::snprintf(buf, sizeof buf, "%s at (%.2f, %.2f, %.2f)", what, p.x(), p.y(), p.z());
-  return buf;
-}
-
 // z_1 … up to `end`: steps of at most h_c, landing on each target that can be reached in
 // steps no thinner than h_min.
 std::vector<double> core_boundaries(double h1, double h_c, double h_min, double end,
@@ -73,9 +67,9 @@ Under under_shell(const TriangleMesh& mesh, const std::vector<char>& in_patch, c
     for (const Vec3& q : {v[0], v[1], v[2], c})
       if (s.in_region(q.x(), q.y()) && q.z() > s.bottom(q.x(), q.y()) - margin) {
         if (u.why.empty())
-          u.why = at(is_overhang ? "an overhang lies under the shell"
-                                 : "another printable surface lies under the shell",
-                     q);
+          u.why = notice_at(is_overhang ? "an overhang lies under the shell"
+                                        : "another printable surface lies under the shell",
+                            q);
         u.faces[f] = 1;
         break;
       }

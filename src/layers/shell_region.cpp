@@ -19,12 +19,6 @@ constexpr double kNarrowest = 0.7;   ///< mm: R narrower than this would print n
 constexpr double kMostBanded = 0.5;  ///< share of the patch a shell may print in bands
 constexpr int kMaxLevels = 8;        ///< heights g may print the shell at (shell_levels.hpp)
 
-std::string at(const char* what, const Vec3& p) {
-  char buf[240];
-  std::snprintf(buf, sizeof buf, "%s at (%.2f, %.2f, %.2f)", what, p.x(), p.y(), p.z());
-  return buf;
-}
-
 struct Raster {
   const FacetedTop& t;
   std::size_t index(int i, int j) const { return static_cast<std::size_t>(i) * t.ny + j; }
@@ -261,7 +255,7 @@ ShellRegion shell_region(const TriangleMesh& mesh, const std::vector<char>& in_p
     if (patch_node[q]) ++on_patch, in_r += !grown[q], ++count[static_cast<int>(above[q])];
   out.left_out = static_cast<double>(on_patch - in_r) * top.cell * top.cell;
   // Why, as the marks on the patch say (an overhang: the caller says where).
-  if (count[kAboveH] > 0) out.why_out.push_back(at("the part stands above it", first));
+  if (count[kAboveH] > 0) out.why_out.push_back(notice_at("the part stands above it", first));
   if (count[kSteep] > 0) {
     char buf[200];
     std::snprintf(buf, sizeof buf, "steeper than max_angle (%.1f deg) near (%.2f, %.2f)",
@@ -271,7 +265,7 @@ ShellRegion shell_region(const TriangleMesh& mesh, const std::vector<char>& in_p
   if (count[kNarrow] > 0 && out.why_out.empty() && count[kKept] == 0)
     out.why_out.push_back("too narrow for the shell's lines between what the core prints");
   if (on_patch == 0 || 2 * in_r < on_patch) {
-    out.refused = at("the part stands above most of the curved top", first);
+    out.refused = notice_at("the part stands above most of the curved top", first);
     return out;
   }
   // d: to the nodes outside R, where the core prints whole, not to the marks alone: R also
@@ -291,6 +285,12 @@ ShellRegion shell_region(const TriangleMesh& mesh, const std::vector<char>& in_p
     out.refused = buf;
   }
   return out;
+}
+
+std::string notice_at(const char* what, const Vec3& p) {
+  char buf[240];
+  std::snprintf(buf, sizeof buf, "%s at (%.2f, %.2f, %.2f)", what, p.x(), p.y(), p.z());
+  return buf;
 }
 
 }  // namespace nonplanar::layers

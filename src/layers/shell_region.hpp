@@ -37,6 +37,9 @@
 
 namespace nonplanar::layers {
 
+/// "WHAT at (x, y, z)", the place a shell notice names (mm, two decimals).
+std::string notice_at(const char* what, const Vec3& p);
+
 struct ShellRegion {
   /// +1 at the nodes of R, −1 elsewhere, on H's raster (its marching-squares contour at 0 is
   /// R's outline); empty when R is the whole raster (nothing of the part stands above H).

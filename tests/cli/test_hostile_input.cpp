@@ -35,10 +35,6 @@ CliRun cli(const std::string& args, int limit_s = 300) {
   return test::run_cli(args, limit_s);
 }
 
-std::size_t lines(const std::string& s) {
-  return static_cast<std::size_t>(std::count(s.begin(), s.end(), '\n'));
-}
-
 // Files in `dir` (hidden ones too): what a failed or interrupted run must not leave.
 std::vector<std::string> listing(const fs::path& dir) {
   std::vector<std::string> names;
@@ -56,7 +52,7 @@ void expect_clean_outcome(const fs::path& model, const std::string& what) {
   const CliRun s = cli("slice -q " + model.string() + " -o " + out.string());
   ASSERT_TRUE(s.code == 0 || s.code == 2) << what << ": slice exit " << s.code << "\n" << s.err;
   if (s.code == 2) {
-    EXPECT_EQ(lines(s.err), 1u) << what << ": " << s.err;
+    EXPECT_EQ(test::count_lines(s.err), 1u) << what << ": " << s.err;
     EXPECT_NE(s.err.find(model.filename().string()), std::string::npos) << what << ": " << s.err;
     EXPECT_TRUE(listing(out_dir).empty()) << what << ": a failed run left a file";
     return;
@@ -184,7 +180,7 @@ TEST(HostileInput, CheckThatMeasuresNothingSaysSo) {
     test::write_bytes(g, text);
     const CliRun r = cli("check " + g.string() + mesh);
     EXPECT_EQ(r.code, 2) << name << ": " << r.out << r.err;
-    EXPECT_EQ(lines(r.err), 1u) << name << ": " << r.err;
+    EXPECT_EQ(test::count_lines(r.err), 1u) << name << ": " << r.err;
     EXPECT_NE(r.err.find(g.string() + ": "), std::string::npos) << r.err;
   }
   test::write_bytes(dir / "good.gcode", good);
@@ -221,7 +217,7 @@ TEST(HostileInput, LimitsAreErrorsNamingTheKeyOrSizes) {
   for (const auto& [args, key] : cases) {
     const CliRun r = cli("slice -q " + small + " -o " + out + " " + args);
     EXPECT_EQ(r.code, 2) << args;
-    EXPECT_EQ(lines(r.err), 1u) << args << ": " << r.err;
+    EXPECT_EQ(test::count_lines(r.err), 1u) << args << ": " << r.err;
     EXPECT_NE(r.err.find(key), std::string::npos) << args << ": " << r.err;
     EXPECT_FALSE(fs::exists(out)) << args;
   }

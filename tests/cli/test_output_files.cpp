@@ -20,10 +20,6 @@ namespace {
 namespace fs = std::filesystem;
 using test::run_cli;
 
-std::size_t lines(const std::string& s) {
-  return static_cast<std::size_t>(std::count(s.begin(), s.end(), '\n'));
-}
-
 fs::path small_box(const fs::path& dir) {
   const fs::path p = dir / "box.stl";
   EXPECT_TRUE(write_stl(p, test::box({0, 0, 0}, {10, 10, 2})));
@@ -91,7 +87,7 @@ TEST(OutputFiles, TheInputIsNeverOverwritten) {
         "fit -q " + model.string() + " --export-surfaces " + other + " --export-mesh " + other}) {
     const auto r = run_cli(args);
     EXPECT_EQ(r.code, 2) << args << "\n" << r.err;
-    EXPECT_EQ(lines(r.err), 1u) << args << "\n" << r.err;
+    EXPECT_EQ(test::count_lines(r.err), 1u) << args << "\n" << r.err;
     EXPECT_TRUE(r.err.find("would be overwritten") != std::string::npos ||
                 r.err.find("cannot share a file") != std::string::npos)
         << r.err;

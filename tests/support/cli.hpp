@@ -3,6 +3,7 @@
 
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <string>
 
@@ -24,6 +25,11 @@ inline CliResult run_cli(const std::string& args, int limit_s = 300) {
   const int status = std::system(cmd.c_str());
   return {WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status), read_bytes(dir / "out"),
           read_bytes(dir / "err")};
+}
+
+/// How many lines a text has (its line ends): a one-line error is 1.
+inline std::size_t count_lines(const std::string& s) {
+  return static_cast<std::size_t>(std::count(s.begin(), s.end(), '\n'));
 }
 
 }  // namespace nonplanar::test
