@@ -146,6 +146,18 @@ Expected<PrintConfig> load_config(const std::filesystem::path& file, PrintConfig
 /// when the file has none (our built-in engine's).
 std::string gcode_config_block(std::string_view gcode);
 
+/// The keys the time and filament figures read from the profile (they have no field of their
+/// own): PrusaSlicer's machine limits, junction deviation, stealth mode and M73 switches, and
+/// the filament's density and cost.
+bool read_by_print_stats(const std::string& key);
+
+/// Adds to the settings block of `gcode` (gcode_config_block's) each key of `c.profile` that
+/// read_by_print_stats names and the block lacks, as "; key = value" before the block's end
+/// line. An engine leaves out what it does not know (PrusaSlicer 2.5:
+/// machine_max_junction_deviation), and `check` would then time the file without it. Returns
+/// how many lines were added (none without a block).
+std::size_t complete_config_block(std::string& gcode, const PrintConfig& c);
+
 /// OrcaSlicer's profiles (docs/orcaslicer-profiles.md). Is this JSON one (a "type" of
 /// machine, process or filament, or an "inherits")?
 bool is_orca_profile(std::string_view json_text);

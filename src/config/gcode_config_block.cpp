@@ -34,4 +34,25 @@ std::string gcode_config_block(std::string_view gcode) {
   return ini;
 }
 
+std::size_t complete_config_block(std::string& gcode, const PrintConfig& c) {
+  std::string_view end = "; prusaslicer_config = end";
+  std::size_t e = gcode.rfind(end);
+  if (e == std::string::npos) end = "; CONFIG_BLOCK_END", e = gcode.rfind(end);
+  if (e == std::string::npos || (e > 0 && gcode[e - 1] != '\n')) return 0;
+  const std::string block = gcode_config_block(gcode);
+  if (block.empty()) return 0;
+  auto has = [&](const std::string& key) {
+    for (std::size_t at = block.find(key + " ="); at != std::string::npos;
+         at = block.find(key + " =", at + 1))
+      if (at == 0 || block[at - 1] == '\n') return true;
+    return false;
+  };
+  std::string add;
+  std::size_t n = 0;
+  for (const auto& [key, value] : c.profile)  // a std::map: in key order, as the block's
+    if (read_by_print_stats(key) && !has(key)) add += "; " + key + " = " + value + "\n", ++n;
+  gcode.insert(e, add);
+  return n;
+}
+
 }  // namespace nonplanar

@@ -13,19 +13,6 @@
 namespace nonplanar {
 namespace {
 
-// The keys the built-in engine's time and filament figures read from the profile (they have
-// no field of their own): PrusaSlicer's machine limits, its stealth mode and M73 switches, and
-// the filament's density and cost.
-bool read_by_print_stats(const std::string& key) {
-  static const char* const prefixes[] = {"machine_max_feedrate_", "machine_max_acceleration_",
-                                         "machine_max_jerk_"};
-  for (const char* p : prefixes)
-    if (key.rfind(p, 0) == 0 && key.size() > std::strlen(p)) return true;
-  return key == "machine_min_extruding_rate" || key == "machine_min_travel_rate" ||
-         key == "machine_max_junction_deviation" || key == "silent_mode" ||
-         key == "remaining_times" || key == "filament_density" || key == "filament_cost";
-}
-
 Error bad(const std::string& key, const std::string& why) {
   return Error{Status::invalid_argument, key + ": " + why};
 }
@@ -279,6 +266,16 @@ Expected<bool> set_value(PrintConfig& c, const std::string& key, const std::stri
 }
 
 }  // namespace
+
+bool read_by_print_stats(const std::string& key) {
+  static const char* const prefixes[] = {"machine_max_feedrate_", "machine_max_acceleration_",
+                                         "machine_max_jerk_"};
+  for (const char* p : prefixes)
+    if (key.rfind(p, 0) == 0 && key.size() > std::strlen(p)) return true;
+  return key == "machine_min_extruding_rate" || key == "machine_min_travel_rate" ||
+         key == "machine_max_junction_deviation" || key == "silent_mode" ||
+         key == "remaining_times" || key == "filament_density" || key == "filament_cost";
+}
 
 Expected<bool> set_config_value(PrintConfig& c, const std::string& key, const std::string& value) {
   auto r = set_value(c, key, value);

@@ -317,6 +317,7 @@ Expected<std::string> run_engine(const EngineParams& e, const TriangleMesh& mesh
                      "'s G-code stops before its end (no statistics or config block after the "
                      "last layer): a truncated file is not printed"};
   if (auto f = flavor_kept(c, gcode, name)) return *f;
+  complete_config_block(gcode, c);  // the file says what its time estimate assumed
   return gcode;
 }
 

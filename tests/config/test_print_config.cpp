@@ -157,6 +157,29 @@ TEST(Config, MachineLimitsAreSettingsTheEstimateReads) {
   EXPECT_FALSE(*set_config_value(c, "machine_max_jerk_", "3"));  // no axis: not ours
 }
 
+// An engine leaves out of its settings block what it does not know (PrusaSlicer 2.5: junction
+// deviation): the file then gets the user's value, so `check` times it as its footer did.
+TEST(Config, TheSettingsBlockGetsTheTimingKeysTheEngineLeftOut) {
+  PrintConfig c;
+  ASSERT_TRUE(set_config_value(c, "machine_max_junction_deviation", "0.02"));
+  ASSERT_TRUE(set_config_value(c, "machine_max_jerk_x", "8"));
+  ASSERT_TRUE(set_config_value(c, "layer_height", "0.15"));  // not a timing key
+  const std::string head = "G1 X1 E1\n; prusaslicer_config = begin\n; layer_height = 0.2\n";
+  std::string g = head + "; machine_max_jerk_x = 10\n; prusaslicer_config = end\n";
+  EXPECT_EQ(complete_config_block(g, c), 1u);
+  EXPECT_EQ(g, head +
+                   "; machine_max_jerk_x = 10\n; machine_max_junction_deviation = 0.02\n"
+                   "; prusaslicer_config = end\n");
+  auto read = parse_ini_config(gcode_config_block(g));
+  ASSERT_TRUE(read) << read.error().message;
+  EXPECT_EQ(machine_limits(*read).junction_deviation, 0.02);
+  EXPECT_EQ(machine_limits(*read).jerk_x, 10);  // the engine's own value stays
+  EXPECT_EQ(complete_config_block(g, c), 0u);   // once only
+  std::string none = "G1 X1 E1\n";  // no block (the built-in engine's): nothing to complete
+  EXPECT_EQ(complete_config_block(none, c), 0u);
+  EXPECT_EQ(none, "G1 X1 E1\n");
+}
+
 TEST(Config, UnknownFillPatternIsAnErrorAndPrusaSlicersAreNoted) {
   PrintConfig c;
   auto typo = set_config_value(c, "fill_pattern", "nosuchpattern");

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -171,6 +172,30 @@ TEST(EnginePrusaSlicer, EngineOnlyKeysReachTheEngine) {
   EXPECT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.err.find("does not print brim_width = 5"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("--engine prusaslicer prints them"), std::string::npos) << r.err;
+}
+
+// PrusaSlicer 2.5 leaves machine_max_junction_deviation out of its settings block; the file
+// gets the user's value there, so `check` times it as the footer was timed (#17).
+TEST(EnginePrusaSlicer, TheFileKeepsTheJunctionDeviationItWasTimedWith) {
+  if (!have_prusaslicer()) GTEST_SKIP() << "prusa-slicer not installed";
+  const auto dir = test::temp_dir("engine_jd");
+  const auto stl = dir / "b.stl";
+  ASSERT_TRUE(write_stl(stl, test::box({0, 0, 0}, {20, 20, 2})));
+  const auto out = dir / "b.gcode";
+  auto r = test::run_cli("slice -q " + stl.string() + " --planar --engine prusaslicer " +
+                         "--set machine_max_junction_deviation=0.05 -o " + out.string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(test::read_bytes(out).find("\n; machine_max_junction_deviation = 0.05\n"),
+            std::string::npos);
+  auto seconds = [&](const std::string& set) {
+    const auto chk =
+        test::run_cli("check -q --json " + out.string() + " --mesh " + stl.string() + set);
+    EXPECT_EQ(chk.code, 0) << chk.err;
+    return nlohmann::json::parse(chk.out)["print_time_s"].get<double>();
+  };
+  const double as_written = seconds("");
+  EXPECT_DOUBLE_EQ(as_written, seconds(" --set machine_max_junction_deviation=0.05"));
+  EXPECT_GT(std::abs(as_written - seconds(" --set machine_max_junction_deviation=0")), 1.0);
 }
 
 TEST(EngineOption, BadEngineOrMissingExecutableIsAOneLineError) {
