@@ -56,8 +56,9 @@ struct PreviewOptions {
 std::vector<Vec3> breaches(const CheckFigures& f, const PrintConfig& cfg, double max_angle) {
   const SliceJob job = make_job(cfg, max_angle);
   std::vector<Vec3> at;
-  if (f.thickness_min < job.layers.min_layer_height - 1e-3) at.push_back(f.thickness_min_at);
-  if (f.thickness_max > job.layers.max_layer_height + 1e-3) at.push_back(f.thickness_max_at);
+  const double slack = job.gate.thickness_slack;  // what the slicer's own gate lets through
+  if (f.thickness_min < job.layers.min_layer_height - slack) at.push_back(f.thickness_min_at);
+  if (f.thickness_max > job.layers.max_layer_height + slack) at.push_back(f.thickness_max_at);
   return at;
 }
 

@@ -9,6 +9,7 @@
 
 #include "nonplanar/context.hpp"
 #include "nonplanar/layers.hpp"
+#include "nonplanar/program.hpp"
 #include "nonplanar/toolpaths.hpp"
 
 namespace nonplanar {
@@ -39,6 +40,10 @@ struct MapBackParams {
   // Travels over curved layers (travel_height, toolhead.hpp); mm.
   double tip_radius = 0.4;   ///< the nozzle tip's flat (Toolhead::tip_radius)
   double travel_lift = 0.3;  ///< over the layer's highest point: travel_lift(retract_lift)
+  /// Another slicer's G-code: where a layer under a shell is cut, when the passes retract.
+  LayerPassParams passes;
+  /// The points a mapped file may have (a count): past it the file is refused as broken.
+  std::size_t most_points = 50'000'000;
 };
 
 /// Maps toolpaths sliced from the normalised mesh back onto the curved layers:

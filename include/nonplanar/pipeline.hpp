@@ -32,12 +32,25 @@ struct Notice {
   bool names_a_fix = false;  ///< it names a setting and a value that would print it curved
 };
 
+/// How close to a limit the safety gate lets a printed path come (DESIGN.md §3): what the
+/// file's rounding to µm may add, and no more.
+struct GateParams {
+  /// A layer may be this much thinner than h_min or thicker than h_max, mm.
+  double thickness_slack = 1e-3;
+  /// An extrusion may be this much steeper than max_angle, degrees.
+  double angle_slack_deg = 0.5;
+  /// The slope is judged over segments at least this long in XY, mm (a shorter one's slope is
+  /// the rounding of its ends).
+  double slope_run = 0.05;
+};
+
 struct SliceJob {
   AnalysisParams analysis;
   FitParams fit;
   LayerParams layers;           ///< layer heights and printer limits; set from print by make_job
   MapBackParams map_back;       ///< mapping paths and another engine's G-code back; by make_job
   CheckParams check;            ///< the safety gate's limits and head; set by make_job
+  GateParams gate;              ///< how near those limits the gate lets a path come
   std::vector<Notice> notices;  ///< what make_job adapted (passed on to the result)
   PrintConfig print;
   bool planar_only = false;

@@ -128,6 +128,22 @@ struct GcodeLineCount {
 };
 GcodeLineCount count_gcode_lines(std::string_view text);
 
+/// The thresholds of the passes that rewrite a layer being mapped onto curved layers
+/// (layer_passes.hpp: clip_layer, order_top_skins). mm unless named otherwise.
+struct LayerPassParams {
+  /// Where a layer under a shell is cut: the margin is looked at every clip_step along a move,
+  /// then each change of side is bisected.
+  double clip_step = 0.05;
+  /// A stretch cut away that is longer than this is travelled retracted, as PrusaSlicer's
+  /// retract_before_travel (2 mm) would have it.
+  double clip_retract_over = 2.0;
+  /// The margins a whole file may look up (a count, not mm): past it the file is refused as
+  /// broken, not a print (a print needs a few million).
+  std::size_t most_clip_samples = 50'000'000;
+  /// A travel between two reordered top-skin strokes longer than this is retracted around.
+  double skin_retract_over = 1.0;
+};
+
 /// One G0/G1 move with what it deposited (check's input).
 struct PrintMove {
   Vec3 from{0, 0, 0}, to{0, 0, 0};

@@ -67,10 +67,11 @@ bool kept(const std::vector<char>& planar_lines, const GcodeMove& m) {
 }
 
 // Maps the layer's extrusions and wipes into work.mapped, and sets L's highest point and
-// steepest slope (which set how its travels clear it). Error past 50 million points.
-std::optional<Error> map_layer(LayerWork& work, const LayerField& field, double tolerance,
-                               const std::vector<char>& planar_lines, LayerToolpaths& L,
-                               std::size_t& points) {
+// steepest slope (which set how its travels clear it). Error once the file's points pass
+// params.most_points.
+std::optional<Error> map_layer(LayerWork& work, const LayerField& field,
+                               const MapBackParams& params, const std::vector<char>& planar_lines,
+                               LayerToolpaths& L, std::size_t& points) {
   L.max_z = -1e300;
   for (const GcodeLine& it : work.lines) {
     if (it.kind != Kind::move) continue;
@@ -86,11 +87,12 @@ std::optional<Error> map_layer(LayerWork& work, const LayerField& field, double 
     const Mapped a = map_point(field, m.from, m.height), b = map_point(field, m.to, m.height);
     p.points.push_back(a.p);
     p.height.push_back(a.height);
-    map_segment(field, m.from, a, m.to, b, m.height, tolerance, 0, p);
+    map_segment(field, m.from, a, m.to, b, m.height, params.tolerance, 0, p);
     points += p.points.size();
-    if (points > 50'000'000)
-      return Error{Status::invalid_argument,
-                   "line " + std::to_string(m.line) + ": more than 50 million mapped points"};
+    if (points > params.most_points)
+      return Error{Status::invalid_argument, "line " + std::to_string(m.line) + ": more than " +
+                                                 std::to_string(params.most_points) +
+                                                 " mapped points"};
     add_to_reach(p, L);
   }
   if (L.max_z < -1e299) L.max_z = 0;
@@ -275,14 +277,15 @@ Expected<ForeignGcode> map_foreign_gcode(std::string_view text, const LayerField
     }
     if (cover == LayerClip::Cover::some) {
       auto margin = [&](double x, double y) { return options.clip->margin(x, y, z); };
-      if (const int bad = program::clip_layer(work, margin, prog.retraction, clip_samples))
-        return Error{Status::invalid_argument,
-                     "line " + std::to_string(bad) + ": more than 50 million clip samples"};
+      if (const int bad =
+              program::clip_layer(work, margin, prog.retraction, params.passes, clip_samples))
+        return Error{Status::invalid_argument, "line " + std::to_string(bad) + ": more than " +
+                                                   std::to_string(params.passes.most_clip_samples) +
+                                                   " clip samples"};
     }
-    if (auto e =
-            map_layer(work, field, params.tolerance, options.planar_lines, out.layers[lu], points))
+    if (auto e = map_layer(work, field, params, options.planar_lines, out.layers[lu], points))
       return *e;
-    program::order_top_skins(work);
+    program::order_top_skins(work, params.passes);
     write_layer(work, field, params, options.planar_lines, prog.layer_height[lu], out.layers[lu],
                 s);
     if (ctx.cancelled()) return Error{Status::cancelled, "cancelled"};

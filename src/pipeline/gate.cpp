@@ -43,11 +43,12 @@ Expected<void> write_program(SliceResult& r, const SliceJob& job, const Context&
 
 namespace {
 
-// Thickness within [h_min, h_max] and slope within max_angle + 0.5° on the paths (their points
-// on the file's µm grid, engine_route.hpp); fills r's thickness and steepest figures.
-bool limits(SliceResult& r, const LayerParams& L, const Violation& violation) {
+// Thickness within [h_min, h_max] and slope within max_angle on the paths (their points on
+// the file's µm grid, engine_route.hpp), each with g's slack; fills r's thickness and
+// steepest figures.
+bool limits(SliceResult& r, const LayerParams& L, const GateParams& g, const Violation& violation) {
   r.thickness_min = 1e300, r.thickness_max = 0;
-  const double tan_max = std::tan((L.max_angle_deg + 0.5) * M_PI / 180.0);
+  const double tan_max = std::tan((L.max_angle_deg + g.angle_slack_deg) * M_PI / 180.0);
   for (std::size_t li = 0; li < r.layers.size(); ++li)
     for (const ExtrusionPath& p : r.layers[li].paths) {
       if (p.role == ExtrusionRole::skirt) continue;
@@ -55,17 +56,17 @@ bool limits(SliceResult& r, const LayerParams& L, const Violation& violation) {
         if (li > 0) {
           r.thickness_min = std::min(r.thickness_min, p.height[k]);
           r.thickness_max = std::max(r.thickness_max, p.height[k]);
-          if ((p.height[k] < L.min_layer_height - 1e-3 ||
-               p.height[k] > L.max_layer_height + 1e-3) &&
+          if ((p.height[k] < L.min_layer_height - g.thickness_slack ||
+               p.height[k] > L.max_layer_height + g.thickness_slack) &&
               !violation(p.points[k], "a layer leaves the thickness limits"))
             return false;
         }
         if (k == 0) continue;
         const double dxy = (p.points[k] - p.points[k - 1]).head<2>().norm();
         const double dz = std::abs(p.points[k].z() - p.points[k - 1].z());
-        if (dxy > 0.05) r.steepest_deg = std::max(r.steepest_deg, std::atan2(dz, dxy) * 180 / M_PI);
-        if (dxy > 0.05 && dz > tan_max * dxy &&
-            !violation(p.points[k], "an extrusion is steeper than max_angle"))
+        if (dxy <= g.slope_run) continue;
+        r.steepest_deg = std::max(r.steepest_deg, std::atan2(dz, dxy) * 180 / M_PI);
+        if (dz > tan_max * dxy && !violation(p.points[k], "an extrusion is steeper than max_angle"))
           return false;
       }
     }
@@ -78,7 +79,7 @@ bool limits(SliceResult& r, const LayerParams& L, const Violation& violation) {
 Expected<bool> gate(SliceResult& r, const SliceJob& job, const layers::BandedField* banded,
                     const Violation& violation, const Context& ctx) {
   ctx.progress("gate", 0);
-  if (!limits(r, job.layers, violation)) return false;
+  if (!limits(r, job.layers, job.gate, violation)) return false;
   if (!r.nonplanar) return true;  // planar layers cannot dig into earlier ones
   // Collisions: in the program about to be written, read back as `check` reads the file, so
   // the two agree to the last digit. They are looked for even when bands already broke a

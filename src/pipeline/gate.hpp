@@ -15,11 +15,11 @@ using Violation = std::function<bool(const Vec3&, const char*)>;
 /// Inputs: the result about to be written (its layers), the job's limits and toolhead, the
 /// field's bands when the part has curved stacks (collisions are then looked for only near
 /// them: gate_zones.hpp; null: everywhere). Checks thickness within [h_min, h_max] and slope
-/// within max_angle + 0.5° on the paths, and, when something is curved, collisions with
-/// earlier layers in the program about to be written (r.gcode, made here by write_program
-/// when empty), read back by the one reader and searched by check's own collision search.
-/// Every breach goes to `violation`. Output: false when `violation` said stop; fills r's
-/// figures. Errors: those of write_program, cancelled.
+/// within max_angle on the paths (with job.gate's slack), and, when something is curved, collisions
+/// with earlier layers in the program about to be written (r.gcode, made here by write_program when
+/// empty), read back by the one reader and searched by check's own collision search. Every breach
+/// goes to `violation`. Output: false when `violation` said stop; fills r's figures. Errors: those
+/// of write_program, cancelled.
 Expected<bool> gate(SliceResult& r, const SliceJob& job, const layers::BandedField* banded,
                     const Violation& violation, const Context& ctx);
 

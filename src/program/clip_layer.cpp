@@ -51,7 +51,7 @@ Pieces cut_move(const G& g, double len, int n) {
 }  // namespace
 
 int clip_layer(LayerWork& w, const std::function<double(double, double)>& margin,
-               const GcodeRetraction& ret, std::size_t& samples) {
+               const GcodeRetraction& ret, const LayerPassParams& params, std::size_t& samples) {
   std::vector<GcodeLine> out;
   out.reserve(w.lines.size());
   // The give-back of a retraction around cut-away travel: held while the travel goes on (the
@@ -75,9 +75,9 @@ int clip_layer(LayerWork& w, const std::function<double(double, double)>& margin
       return margin(p.x(), p.y());
     };
     const double len = (m.to - m.from).head<2>().norm();
-    const int n = std::max(1, static_cast<int>(std::ceil(len / 0.05)));
+    const int n = std::max(1, static_cast<int>(std::ceil(len / params.clip_step)));
     samples += static_cast<std::size_t>(n) + 1;
-    if (samples > 50'000'000) return m.line;
+    if (samples > params.most_clip_samples) return m.line;
     const Pieces pieces = cut_move(g, len, n);
     const std::vector<double>& cuts = pieces.cuts;
     if (cuts.size() == 2 && pieces.kept[0]) {
@@ -95,7 +95,8 @@ int clip_layer(LayerWork& w, const std::function<double(double, double)>& margin
         continue;
       }
       piece.de = 0, piece.has_e = false;
-      const bool hop = ret.length > 0 && (owed || (piece.to - piece.from).head<2>().norm() > 2.0);
+      const bool hop = ret.length > 0 && (owed || (piece.to - piece.from).head<2>().norm() >
+                                                      params.clip_retract_over);
       GcodeMove r = piece;
       r.has_xy = false, r.has_e = true;
       if (hop && !owed) {

@@ -43,15 +43,16 @@ LowToHigh low_to_high(const std::vector<StrokeHeights>& strokes);
 /// end; the travels between them are made anew, with the run's own retraction around them
 /// (travels over 1 mm) and its extrusion feed rate after. The run's trailing wipes become
 /// plain retractions (their path retraced the old last stroke). Needs `mapped` filled.
-void order_top_skins(LayerWork& layer);
+/// Travels over p.skin_retract_over are retracted around.
+void order_top_skins(LayerWork& layer, const LayerPassParams& p = {});
 
 /// Cuts each extrusion of the layer to where margin(x, y) >= 0 (a continuous function, mm):
 /// kept pieces extrude their share of E, the rest become travels, retracted around (`ret`,
-/// the file's own retraction) when longer than 2 mm, as PrusaSlicer's retract_before_travel
-/// does. Crossings are found on 0.05 mm steps and bisected. `samples` counts the margins
-/// looked up; past 50 million (a broken file, not a print) it stops and returns the line it
-/// was on (else 0). Runs before mapping: `mapped` entries of new moves are empty.
+/// the file's own retraction) when longer than p.clip_retract_over. Crossings are found on
+/// p.clip_step steps and bisected. `samples` counts the margins looked up; past
+/// p.most_clip_samples it stops and returns the line it was on (else 0). Runs before mapping:
+/// `mapped` entries of new moves are empty.
 int clip_layer(LayerWork& layer, const std::function<double(double x, double y)>& margin,
-               const GcodeRetraction& ret, std::size_t& samples);
+               const GcodeRetraction& ret, const LayerPassParams& p, std::size_t& samples);
 
 }  // namespace nonplanar::program

@@ -87,9 +87,9 @@ Run collect_run(LayerWork& w, std::size_t s, std::size_t e) {
 }
 
 // The travel from prev to the start of `stroke` (low end first), retracted around when over
-// 1 mm, then the stroke; appended to out. Returns where the stroke ends.
+// retract_over, then the stroke; appended to out. Returns where the stroke ends.
 Vec3 write_stroke(LayerWork& w, const Run& r, const std::vector<int>& stroke, bool reverse,
-                  const Vec3& prev, std::vector<GcodeLine>& out) {
+                  const Vec3& prev, double retract_over, std::vector<GcodeLine>& out) {
   GcodeMove travel = w.moves[static_cast<std::size_t>(reverse ? stroke.back() : stroke.front())];
   const Vec3 start = reverse ? travel.to : travel.from;
   travel.from = prev, travel.to = start, travel.has_xy = true, travel.has_z = false;
@@ -97,7 +97,7 @@ Vec3 write_stroke(LayerWork& w, const Run& r, const std::vector<int>& stroke, bo
   GcodeMove back = travel;
   back.has_xy = false, back.from = back.to = prev, back.has_e = true, back.de = -r.ret;
   back.f = r.ret_f;
-  const bool hop = r.ret > 0 && (start - prev).head<2>().norm() > 1.0;
+  const bool hop = r.ret > 0 && (start - prev).head<2>().norm() > retract_over;
   if (hop) out.push_back(w.add(back));
   out.push_back(w.add(travel));
   if (hop) {
@@ -123,7 +123,7 @@ Vec3 write_stroke(LayerWork& w, const Run& r, const std::vector<int>& stroke, bo
 
 }  // namespace
 
-void order_top_skins(LayerWork& w) {
+void order_top_skins(LayerWork& w, const LayerPassParams& params) {
   auto heights = [&](const std::vector<int>& stroke) {
     StrokeHeights h;
     std::size_t n = 0;
@@ -148,7 +148,8 @@ void order_top_skins(LayerWork& w) {
     out.insert(out.end(), r.head.begin(), r.head.end());
     Vec3 prev = w.moves[static_cast<std::size_t>(r.strokes[order.order[0]].front())].from;
     for (std::size_t k : order.order)
-      prev = write_stroke(w, r, r.strokes[k], order.reverse[k] != 0, prev, out);
+      prev = write_stroke(w, r, r.strokes[k], order.reverse[k] != 0, prev, params.skin_retract_over,
+                          out);
     out.insert(out.end(), r.tail.begin(), r.tail.end());
     seq.erase(seq.begin() + static_cast<long>(s), seq.begin() + static_cast<long>(e));
     seq.insert(seq.begin() + static_cast<long>(s), out.begin(), out.end());
