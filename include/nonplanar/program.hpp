@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <functional>
 #include <limits>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -113,6 +114,13 @@ struct GcodeProgram {
 /// or unknown word in a move) is listed in `problems`, each with its line; home and probe
 /// (G28, G29) too, marked moves_head.
 GcodeProgram read_gcode_program(std::string_view text);
+
+/// The first thing inside the print (p.in_print) that cannot be mapped onto curved layers, as
+/// a parse_error naming its line: a problem the reader listed (an arc, home or probe, junk, a
+/// bad word), or a coordinate beyond 10 m (no printer is that large, and mapping its moves in
+/// 1 mm pieces would not fit in memory; a move's start counts too, as the start G-code may
+/// have left the nozzle there). Nothing when all of it can.
+std::optional<Error> first_unmappable(const GcodeProgram& p);
 
 /// The same reading, streamed line by line for a caller that needs every line but not all of
 /// them at once (the statistics of a large file): f gets each line in order, with its move

@@ -28,30 +28,6 @@ using Kind = GcodeLine::Kind;
 using program::GcodeText;
 using program::LayerWork;
 
-// The first thing inside the print that cannot be mapped: a problem the reader listed (an
-// arc, home or probe, junk, a bad word), or a coordinate beyond 10 m (no printer is that
-// large, and mapping its moves in 1 mm pieces would not fit in memory; the move's start
-// counts too, as the start G-code may have left the nozzle there).
-std::optional<Error> unmappable(const GcodeProgram& p) {
-  int line = 0;
-  std::string why;
-  for (const GcodeProblem& q : p.problems)
-    if (p.in_print(static_cast<std::size_t>(q.line - 1))) {
-      line = q.line, why = q.why;
-      break;
-    }
-  for (const GcodeMove& m : p.moves) {
-    if (line && m.line >= line) break;
-    if (p.in_print(static_cast<std::size_t>(m.line - 1)) &&
-        std::max(m.to.cwiseAbs().maxCoeff(), m.from.cwiseAbs().maxCoeff()) > 1e4) {
-      line = m.line, why = "coordinate beyond 10 m: not a print this can map";
-      break;
-    }
-  }
-  if (!line) return std::nullopt;
-  return Error{Status::parse_error, "line " + std::to_string(line) + ": " + why};
-}
-
 // What carries over from one layer's writing to the next.
 struct Writing {
   GcodeText w;
@@ -239,7 +215,7 @@ Expected<ForeignGcode> map_foreign_gcode(std::string_view text, const LayerField
   const std::vector<GcodeLine>& lines = prog.lines;
   if (prog.print_begin == lines.size())
     return Error{Status::parse_error, "no ;LAYER_CHANGE: not a layered G-code file"};
-  if (auto e = unmappable(prog)) return *e;
+  if (auto e = first_unmappable(prog)) return *e;
   if (ctx.cancelled()) return Error{Status::cancelled, "cancelled"};
 
   ForeignGcode out;

@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <optional>
+#include <string>
 
 #include "core/huge_pages.hpp"
 #include "core/text_tokens.hpp"
@@ -364,6 +366,26 @@ Expected<std::vector<PrintMove>> read_gcode_moves(std::string_view text) {
     if (!q.moves_head)
       return Error{Status::parse_error, "line " + std::to_string(q.line) + ": " + q.why};
   return moves;
+}
+
+std::optional<Error> first_unmappable(const GcodeProgram& p) {
+  int line = 0;
+  std::string why;
+  for (const GcodeProblem& q : p.problems)
+    if (p.in_print(static_cast<std::size_t>(q.line - 1))) {
+      line = q.line, why = q.why;
+      break;
+    }
+  for (const GcodeMove& m : p.moves) {
+    if (line && m.line >= line) break;
+    if (p.in_print(static_cast<std::size_t>(m.line - 1)) &&
+        std::max(m.to.cwiseAbs().maxCoeff(), m.from.cwiseAbs().maxCoeff()) > 1e4) {
+      line = m.line, why = "coordinate beyond 10 m: not a print this can map";
+      break;
+    }
+  }
+  if (!line) return std::nullopt;
+  return Error{Status::parse_error, "line " + std::to_string(line) + ": " + why};
 }
 
 }  // namespace nonplanar
