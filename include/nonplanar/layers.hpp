@@ -56,6 +56,9 @@ struct LayerStack {
   double max_slope_deg = 0;
   double max_block_rise = 0;  ///< largest rise of a layer within the block radius
   double cost_before = 0, cost_after = 0;
+  /// The cost of the optimiser's own result, kept or not (cost_after is the even
+  /// interpolation's when that result broke a limit).
+  double cost_optimised = 0;
   int iterations = 0;
   std::string optimizer_message;
   /// When no plane let every layer clear the nozzle tip's reach uphill within

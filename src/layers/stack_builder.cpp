@@ -406,6 +406,7 @@ StackResult build_stack(const TriangleMesh& mesh, const Patch& patch, int patch_
   }
   st.cost_before = start ? *start : printability_cost(coarse, Z, terms, nullptr);
   st.cost_after = moved ? printability_cost(coarse, best, terms, nullptr) : st.cost_before;
+  st.cost_optimised = st.cost_after;
   Figures f = measure(grid, best, p, H, dH, st.c);
   const auto ok = [&](const Figures& g) {
     return g.t_min >= p.min_layer_height - 1e-6 && g.t_max <= p.max_layer_height + 1e-6 &&

@@ -212,11 +212,17 @@ TEST(Layers, OptimiserLowersTheCostOfAPoorStart) {
   EXPECT_EQ(r.stack.optimizer_message.find("kept"), std::string::npos) << r.stack.optimizer_message;
   EXPECT_GE(r.stack.thickness_min, lp.min_layer_height - 1e-6);
   EXPECT_LE(r.stack.thickness_max, lp.max_layer_height + 1e-6);
-  // Steepest descent (the paper's eq. 2) also lowers it.
-  lp.optimizer = StackOptimizer::gradient_descent;
-  const auto gd = layers::build_stack(in.mesh, in.patch(), 0, in.top, in.cols, lp, planar, 3.0);
+  // Steepest descent (the paper's eq. 2) also lowers it, by its own steps: in 100 of them
+  // from 2.9e7 to 1.4e5; its result still breaks a limit there (it did at 1000 too), so the even
+  // interpolation is what the stack keeps.
+  LayerParams gd_params = lp;
+  gd_params.optimizer = StackOptimizer::gradient_descent;
+  gd_params.max_iterations = 100;
+  const auto gd =
+      layers::build_stack(in.mesh, in.patch(), 0, in.top, in.cols, gd_params, planar, 3.0);
   ASSERT_TRUE(gd.failure.empty()) << gd.failure;
-  EXPECT_LT(gd.stack.cost_after, 0.9 * gd.stack.cost_before);
+  EXPECT_EQ(gd.stack.iterations, 100);
+  EXPECT_LT(gd.stack.cost_optimised, 0.01 * gd.stack.cost_before);
   // The even interpolation is a stationary point of eq. (1): nothing to improve there.
   const auto even = layers::build_stack(in.mesh, in.patch(), 0, in.top, in.cols, lp, planar, 1.0);
   EXPECT_NEAR(even.stack.cost_after, even.stack.cost_before, 1e-9 * even.stack.cost_before);
@@ -290,6 +296,7 @@ TEST(Deform, NormalisedPlaneKCutsTheOriginalAlongCurvedLayerK) {
   EXPECT_GT(signed_volume(n->mesh), 0.0);
   EXPECT_GT(n->edges_split, 0u);
   const LayerStack& st = p.plan.stacks[0];
+  const test::MeshDistance distance(p.mesh);
   for (int k : {static_cast<int>(st.T_bottom) + st.layers / 2,
                 static_cast<int>(st.T_bottom) + st.layers - 1}) {
     const auto pts = test::plane_cut_points(n->mesh, F.zeta(k));
@@ -297,7 +304,7 @@ TEST(Deform, NormalisedPlaneKCutsTheOriginalAlongCurvedLayerK) {
     double worst = 0;
     for (std::size_t i = 0; i < pts.size(); i += 7) {
       const Vec3 back(pts[i].x(), pts[i].y(), F.z_at(pts[i].x(), pts[i].y(), k));
-      worst = std::max(worst, test::distance_to_mesh(p.mesh, back));
+      worst = std::max(worst, distance(back));
     }
     EXPECT_LE(worst, 0.01) << "layer " << k;
   }

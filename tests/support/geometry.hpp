@@ -1,7 +1,8 @@
-// Geometry helpers for tests: closest point on a triangle, plane cuts of a mesh.
+// Geometry helpers for tests: closest point on a triangle and on a mesh, plane cuts of a mesh.
 #pragma once
 
 #include <algorithm>
+#include <cmath>
 #include <vector>
 
 #include "nonplanar/mesh.hpp"
@@ -30,22 +31,43 @@ inline Vec3 closest_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, con
   return a + ab * (vb * denom) + ac * (vc * denom);
 }
 
-inline double distance_to_mesh(const TriangleMesh& m, const Vec3& p) {
-  double best = 1e300;
-  for (const auto& f : m.faces) {
-    const Vec3& a = m.vertices[f[0]];
-    const Vec3& b = m.vertices[f[1]];
-    const Vec3& c = m.vertices[f[2]];
-    // Cheap reject by bounding box.
-    const Vec3 lo = a.cwiseMin(b).cwiseMin(c), hi = a.cwiseMax(b).cwiseMax(c);
-    const double dx = std::max({lo.x() - p.x(), 0.0, p.x() - hi.x()});
-    const double dy = std::max({lo.y() - p.y(), 0.0, p.y() - hi.y()});
-    const double dz = std::max({lo.z() - p.z(), 0.0, p.z() - hi.z()});
-    if (dx * dx + dy * dy + dz * dz >= best * best) continue;
-    best = std::min(best, (closest_on_triangle(p, a, b, c) - p).norm());
+/// Distances from points to one mesh (mm): every face looked at, but through its box, made
+/// once, so most are passed over at a few comparisons (under the sanitizers the boxes made
+/// anew per point took 25 s of one test).
+class MeshDistance {
+ public:
+  explicit MeshDistance(const TriangleMesh& m) : m_(m) {
+    box_.reserve(6 * m.faces.size());
+    for (const auto& f : m.faces)
+      for (int axis = 0; axis < 3; ++axis) {
+        const double a = m.vertices[f[0]][axis], b = m.vertices[f[1]][axis],
+                     c = m.vertices[f[2]][axis];
+        box_.push_back(std::min({a, b, c}));
+        box_.push_back(std::max({a, b, c}));
+      }
   }
-  return best;
-}
+  double operator()(const Vec3& p) const {
+    double best2 = 1e300;
+    for (std::size_t i = 0; i < m_.faces.size(); ++i) {
+      const double* b = &box_[6 * i];
+      double d2 = 0;
+      for (int axis = 0; axis < 3; ++axis) {
+        const double out = std::max({b[2 * axis] - p[axis], 0.0, p[axis] - b[2 * axis + 1]});
+        d2 += out * out;
+      }
+      if (d2 >= best2) continue;
+      const auto& f = m_.faces[i];
+      const Vec3 q =
+          closest_on_triangle(p, m_.vertices[f[0]], m_.vertices[f[1]], m_.vertices[f[2]]);
+      best2 = std::min(best2, (q - p).squaredNorm());
+    }
+    return std::sqrt(best2);
+  }
+
+ private:
+  const TriangleMesh& m_;
+  std::vector<double> box_;  ///< per face: x lo, x hi, y lo, y hi, z lo, z hi
+};
 
 /// Points where the mesh's edges cross the plane z = h (one per crossing triangle edge).
 inline std::vector<Vec3> plane_cut_points(const TriangleMesh& m, double h) {
