@@ -41,10 +41,10 @@ LowToHigh low_to_high(const std::vector<StrokeHeights>& strokes);
 /// the same layer drags the nozzle's flat through it). In each run of "Top solid infill" the
 /// strokes (unbroken extrusions) are sorted by mean mapped height and each starts at its low
 /// end; the travels between them are made anew, with the run's own retraction around them
-/// (travels over 1 mm) and its extrusion feed rate after. The run's trailing wipes become
-/// plain retractions (their path retraced the old last stroke). Needs `mapped` filled.
-/// Travels over p.skin_retract_over are retracted around.
-void order_top_skins(LayerWork& layer, const LayerPassParams& p = {});
+/// (travels over p.skin_retract_over) and its extrusion feed rate after. The run's trailing
+/// wipes become plain retractions (their path retraced the old last stroke). Needs `mapped`
+/// filled.
+void order_top_skins(LayerWork& layer, const LayerPassParams& p);
 
 /// Cuts each extrusion of the layer to where margin(x, y) >= 0 (a continuous function, mm):
 /// kept pieces extrude their share of E, the rest become travels, retracted around (`ret`,
