@@ -58,11 +58,20 @@ Expected<std::vector<LayerToolpaths>> map_toolpaths_back(const std::vector<Layer
 /// Another slicer's G-code of the normalised mesh, mapped back, and its extrusions (as paths
 /// with heights, for the same safety check as the built-in engine's).
 struct ForeignGcode {
-  std::string text;
+  /// The mapped program in its three blocks: the start (up to the print's first
+  /// ;LAYER_CHANGE), the print (its layers, written from steps), the end (the end G-code, the
+  /// E reset before it included). Two runs join by their blocks (the shell route).
+  std::string start, print, end;
   std::vector<LayerToolpaths> layers;  ///< one per ;LAYER_CHANGE of the print
-  /// Where in `text` the print starts (its first ;LAYER_CHANGE) and where the end G-code
-  /// starts (the E reset before it included), bytes.
-  std::size_t print_begin = 0, print_end = 0;
+  /// The whole program: start, print and end as one text.
+  std::string text() const { return start + print + end; }
+  /// The same, taking the blocks' text (no copy of the print kept).
+  std::string take_text() {
+    std::string t = std::move(start);
+    t.append(print).append(end);
+    print = std::string(), end = std::string();
+    return t;
+  }
   bool relative_e_at_print = false, relative_e_at_end = false;
   double e_at_print = 0;     ///< the file's E when the print starts (absolute E), mm
   std::string fan_at_print;  ///< the start G-code's last M106/M107 line (empty: none)

@@ -1,6 +1,7 @@
-// Stage gcode: the built-in engine's writer, turning toolpaths into G-code (no arcs) through
-// the one emitter (program/), with the annotations PrusaSlicer's and OrcaSlicer's previews
-// read, written atomically. G-code is read by read_gcode_program (program.hpp).
+// Stage gcode: the built-in engine's writer, turning toolpaths into G-code (no arcs): each
+// layer built as steps (ProgramLayer, program.hpp) and written by the one writer (program/),
+// with the annotations PrusaSlicer's and OrcaSlicer's previews read, written atomically.
+// G-code is read by read_gcode_program (program.hpp).
 #pragma once
 
 #include <filesystem>

@@ -1,7 +1,9 @@
-// The print program in the middle (issue: one print program for both engines): G-code as
-// lines and moves, read by the one tolerant reader. The built-in engine's writer, `check`, and
-// the mapping of another slicer's G-code back onto curved layers all read and write G-code
-// through this module. Units: mm, mm of filament for E, mm/min for feed rates (as written).
+// The print program in the middle (issue: one print program for both engines). Read: G-code
+// as lines and moves, by the one tolerant reader (`check`, the gate, and the mapping of another
+// slicer's G-code read so). Written: a start block, then layers of steps (ProgramLayer:
+// extrusions, travels, retractions, lines kept as written), then an end block, through the one
+// writer; the built-in engine and the mapping of another slicer's file both build their layers
+// as steps. Units: mm, mm of filament for E, mm/min for feed rates (as written).
 #pragma once
 
 #include <cstdint>
@@ -114,6 +116,82 @@ struct GcodeProgram {
 /// or unknown word in a move) is listed in `problems`, each with its line; home and probe
 /// (G28, G29) too, marked moves_head.
 GcodeProgram read_gcode_program(std::string_view text);
+
+/// One G1 line of a program being written: where it goes and the words it writes.
+struct ProgramMove {
+  Vec3 to{0, 0, 0};
+  double de = kNoValue;  ///< filament pushed, mm (kNoValue: no E word)
+  double f = kNoValue;   ///< feed rate, mm/min (kNoValue: no F word)
+  /// An extrusion's layer thickness at `to` (the built-in engine's paths, mapped pieces), mm;
+  /// 0 where not known.
+  double height = 0;
+  bool xy = false, z = false;     ///< write X Y; write Z
+  const char* comment = nullptr;  ///< written after " ; " (a string literal)
+};
+
+/// One step of a layer: what one or more G-code lines do.
+struct ProgramStep {
+  enum class Kind : std::uint8_t {
+    raw,             ///< text kept as written, its lines ended: comments, M-codes, blocks
+    z_comment,       ///< ";Z:<value>": the layer's top, %.3f
+    height_comment,  ///< ";HEIGHT:<value>": its thickness, %.3f
+    e_reset,         ///< raw text that sets the E counter to `value` (G92 E)
+    e_mode,          ///< raw text that makes E relative (`value` 1) or absolute (0)
+    travel,          ///< moves that push nothing (a lifted travel: up, across, down); the
+                     ///< last may give back a retraction
+    extrusion,       ///< moves pushing filament along one path of `role`, `width`
+    retract,         ///< one move, E only: pulls filament back (de < 0) or gives it back
+  };
+  Kind kind = Kind::raw;
+  /// raw, e_reset, e_mode: bytes [begin, end) of the layer's text; travel, extrusion,
+  /// retract: its moves [begin, end).
+  std::uint32_t begin = 0, end = 0;
+  double value = 0;                               ///< z_comment, height_comment, e_reset, e_mode
+  ExtrusionRole role = ExtrusionRole::perimeter;  ///< extrusion
+  double width = 0;                               ///< extrusion, mm
+  bool moves() const { return kind >= Kind::travel; }
+};
+
+/// One layer of a program as steps, built by an engine (or by mapping another slicer's layer)
+/// and written by write_program_layer (program/gcode_text.hpp). The writer keeps E (absolute
+/// or relative) across layers, so a layer's steps carry E as pushed, never as a counter.
+class ProgramLayer {
+ public:
+  std::vector<ProgramStep> steps;
+  std::vector<ProgramMove> moves;  ///< the move steps' moves, in order
+  std::string text;                ///< the text steps' bytes
+  /// A line longer than 255 characters was given: the program must be refused.
+  bool too_long = false;
+
+  void clear();
+  /// One line (its end added) / lines already ended (a custom G-code block), as written.
+  void raw(std::string_view line);
+  void block(std::string_view lines);
+  /// printf into one line (at most 255 characters, else too_long).
+  void line(const char* fmt, ...) __attribute__((format(printf, 2, 3)));
+  /// ;Z: and ;HEIGHT: lines; the value can be set later (steps[index].value).
+  std::size_t z_comment(double z);
+  std::size_t height_comment(double h);
+  /// A line that sets E (G92 E…), or its mode (M82 / M83): kept as written, and followed.
+  void e_reset(std::string_view line, double e);
+  void e_mode(std::string_view line, bool relative);
+  /// Starts a step of moves; move() and move_from() add to it.
+  void start(ProgramStep::Kind kind, ExtrusionRole role = ExtrusionRole::perimeter,
+             double width = 0);
+  void move(const ProgramMove& m);
+  /// A move from `from` to p that writes only the axes that change by more than 0.5 µm (what
+  /// %.3f can show), E and F where given; nothing when no word is left.
+  void move_from(const Vec3& from, const Vec3& p, double de, double f, double height = 0);
+  /// A travel that clears a curved layer: up to `lift` where the nozzle is (at), across at
+  /// that height, down to `to` (pushing `de` there, if given: a retraction given back).
+  /// `f_first` on the first line, `f_rest` on the others (kNoValue: none). Its own step.
+  /// travel_height (toolhead.hpp) says how high.
+  void lifted_travel(const Vec3& at, const Vec3& to, double lift, double f_first, double f_rest,
+                     double de = kNoValue);
+
+ private:
+  void text_step(ProgramStep::Kind kind, std::string_view bytes, double value);
+};
 
 /// The first thing inside the print (p.in_print) that cannot be mapped onto curved layers, as
 /// a parse_error naming its line: a problem the reader listed (an arc, home or probe, junk, a

@@ -9,9 +9,10 @@
 // against the planar ones, L·t / (L_p·h)), a wipe follows the layer with its E spread over
 // the pieces, top skins are re-ordered low to high (order_top_skins), and a travel over
 // curved layers rises above the layer's highest point (or, for a hop under 0.6 mm, its
-// slope's reach) and comes down at the target, as the built-in writer does.
+// slope's reach) and comes down at the target, as the built-in writer does. Each layer is
+// built as steps (ProgramLayer) and written by the one writer; the result is three blocks,
+// start, print and end, which the shell route joins.
 #include <algorithm>
-#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <optional>
@@ -31,6 +32,7 @@ using program::LayerWork;
 // What carries over from one layer's writing to the next.
 struct Writing {
   GcodeText w;
+  ProgramLayer layer{};  ///< the layer being built (then written into w)
   Vec3 at{0, 0, 0};      ///< the nozzle, mapped
   double pending = 0;    ///< filament owed from before the print, given back at the first E
   double retracted = 0;  ///< filament the print's own retractions leave pulled back
@@ -75,15 +77,19 @@ std::optional<Error> map_layer(LayerWork& work, const LayerField& field,
   return std::nullopt;
 }
 
-// An extrusion or wipe, one G1 per mapped piece; an extrusion also goes into the gate's path
-// (L.paths[*run], started when *run < 0). Adds the layer thicknesses written to h_sum, h_n.
+// An extrusion or wipe (a travel step, retracting as it goes), one G1 per mapped piece; an
+// extrusion also goes into the gate's path (L.paths[*run], started when *run < 0). Adds the
+// layer thicknesses written to h_sum, h_n.
 void write_pieces(const GcodeMove& m, const ExtrusionPath& p, LayerToolpaths& L, long& run,
                   Writing& s, double& h_sum, std::size_t& h_n) {
   const double lp = (m.to - m.from).norm();
   double l3 = 0;
   for (std::size_t q = 1; q < p.points.size(); ++q) l3 += (p.points[q] - p.points[q - 1]).norm();
   double f = m.f;
-  if (s.pending != 0 && m.has_e) s.w.move_from(s.at, s.at, s.pending, kNoValue), s.pending = 0;
+  if (s.pending != 0 && m.has_e) {
+    s.layer.start(ProgramStep::Kind::retract);
+    s.layer.move_from(s.at, s.at, s.pending, kNoValue), s.pending = 0;
+  }
   if (!m.extruding() && m.has_e) s.retracted -= m.de;
   if (m.extruding() && run < 0) {
     ExtrusionPath g;
@@ -93,6 +99,8 @@ void write_pieces(const GcodeMove& m, const ExtrusionPath& p, LayerToolpaths& L,
     L.paths.push_back(std::move(g));
     run = static_cast<long>(L.paths.size()) - 1;
   }
+  s.layer.start(m.extruding() ? ProgramStep::Kind::extrusion : ProgramStep::Kind::travel,
+                role_from_name(m.type), m.width);
   for (std::size_t q = 1; q < p.points.size(); ++q) {
     const double seg = (p.points[q] - p.points[q - 1]).norm();
     double de;
@@ -106,7 +114,8 @@ void write_pieces(const GcodeMove& m, const ExtrusionPath& p, LayerToolpaths& L,
     } else {
       de = l3 > 0 ? m.de * seg / l3 : 0;
     }
-    s.w.move_from(s.at, p.points[q], m.has_e ? de : kNoValue, f);
+    s.layer.move_from(s.at, p.points[q], m.has_e ? de : kNoValue, f,
+                      m.extruding() ? p.height[q] : 0);
     f = kNoValue;
     s.at = p.points[q];
   }
@@ -120,7 +129,8 @@ void write_travel(const GcodeMove& m, const LayerField& field, const MapBackPara
                   const LayerToolpaths& L, bool keep, Writing& s) {
   if (!m.has_xy && !m.has_z) {  // retraction, F only
     if (m.has_e) s.retracted -= m.de;
-    s.w.move_from(s.at, s.at, m.has_e ? m.de + s.pending : kNoValue, m.f);
+    s.layer.start(ProgramStep::Kind::retract);
+    s.layer.move_from(s.at, s.at, m.has_e ? m.de + s.pending : kNoValue, m.f);
     if (m.has_e) s.pending = 0;
     return;
   }
@@ -136,36 +146,43 @@ void write_travel(const GcodeMove& m, const LayerField& field, const MapBackPara
   const double lift = curved && m.has_xy ? travel_height(s.at, to, L.max_z, L.max_slope,
                                                          params.tip_radius, params.travel_lift)
                                          : kNoValue;
-  if (!std::isnan(lift))
-    program::lifted_travel(s.w, s.at, to, lift, m.f, kNoValue, de);
-  else
-    s.w.move_from(s.at, to, de, m.f);
+  if (!std::isnan(lift)) {
+    s.layer.lifted_travel(s.at, to, lift, m.f, kNoValue, de);
+  } else {
+    s.layer.start(ProgramStep::Kind::travel);
+    s.layer.move_from(s.at, to, de, m.f);
+  }
   s.at = to;
 }
 
-// Writes one mapped layer's lines; ;Z: becomes its highest point and ;HEIGHT: its mean
+// One mapped layer as steps (s.layer); ;Z: becomes its highest point and ;HEIGHT: its mean
 // thickness (planar_h when it extrudes nothing).
-void write_layer(const LayerWork& work, const LayerField& field, const MapBackParams& params,
+void build_layer(const LayerWork& work, const LayerField& field, const MapBackParams& params,
                  const std::vector<char>& planar_lines, double planar_h, LayerToolpaths& L,
                  Writing& s) {
   double h_sum = 0;
   std::size_t h_n = 0;
-  long run = -1;  // the gate's path being extended
+  long run = -1;                              // the gate's path being extended
+  std::vector<std::size_t> z_steps, h_steps;  // filled in once the layer is mapped
   for (const GcodeLine& it : work.lines) {
     switch (it.kind) {
       case Kind::xyz_relative:  // mapped moves are written absolute: the printer stays in G90
-        s.w.raw("; G91 (relative XYZ) applied by nonplanar: the mapped moves are absolute");
+        s.layer.raw("; G91 (relative XYZ) applied by nonplanar: the mapped moves are absolute");
         continue;
       case Kind::text:
-      case Kind::e_reset:
-      case Kind::e_mode:
-        s.w.raw(it.raw);
-        if (it.kind == Kind::e_reset) s.w.set_e(it.value);
-        if (it.kind == Kind::e_mode) s.w.set_relative(it.value != 0);
+        s.layer.raw(it.raw);
         continue;
-      case Kind::z_comment:  // filled in once the layer is written
+      case Kind::e_reset:
+        s.layer.e_reset(it.raw, it.value);
+        continue;
+      case Kind::e_mode:
+        s.layer.e_mode(it.raw, it.value != 0);
+        continue;
+      case Kind::z_comment:
+        z_steps.push_back(s.layer.z_comment(0));
+        continue;
       case Kind::height_comment:
-        s.w.raw(it.kind == Kind::z_comment ? ";Z:@" : ";HEIGHT:@");
+        h_steps.push_back(s.layer.height_comment(0));
         continue;
       case Kind::move:
         break;
@@ -179,30 +196,12 @@ void write_layer(const LayerWork& work, const LayerField& field, const MapBackPa
     run = -1;
     write_travel(m, field, params, L, kept(planar_lines, m), s);
   }
-  char zbuf[32], hbuf[32];
-  std::snprintf(zbuf, sizeof zbuf, ";Z:%.3f", L.max_z);
-  std::snprintf(hbuf, sizeof hbuf, ";HEIGHT:%.3f",
-                h_n ? h_sum / static_cast<double>(h_n) : planar_h);
-  for (const char* key : {";Z:@", ";HEIGHT:@"}) {
-    const std::size_t at_key = s.w.out.rfind(key);
-    if (at_key != std::string::npos)
-      s.w.out.replace(at_key, std::string(key).size(), key[1] == 'Z' ? zbuf : hbuf);
-  }
+  for (const std::size_t k : z_steps) s.layer.steps[k].value = L.max_z;
+  for (const std::size_t k : h_steps)
+    s.layer.steps[k].value = h_n ? h_sum / static_cast<double>(h_n) : planar_h;
   L.z = L.max_z;
   L.height = planar_h;
   L.nonplanar = true;
-}
-
-// A layer the clip left nothing of: only what it tells the printer (temperatures, E mode);
-// not the fan, which follows the layers printed instead (and is turned off at the end).
-void write_dropped_layer(const std::vector<GcodeLine>& lines, Writing& s) {
-  for (const GcodeLine& it : lines)
-    if (it.kind == Kind::text || it.kind == Kind::e_mode)
-      if (!it.raw.empty() && std::toupper(static_cast<unsigned char>(it.raw[0])) == 'M' &&
-          it.raw.rfind("M106", 0) != 0 && it.raw.rfind("M107", 0) != 0) {
-        s.w.raw(it.raw);
-        if (it.kind == Kind::e_mode) s.w.set_relative(it.value != 0);
-      }
 }
 
 }  // namespace
@@ -224,7 +223,8 @@ Expected<ForeignGcode> map_foreign_gcode(std::string_view text, const LayerField
   std::vector<ExtrusionPath> mapped(prog.moves.size());
   std::size_t i = 0;
   for (; i < prog.print_begin; ++i) s.w.raw(lines[i].raw);
-  out.print_begin = s.w.out.size();
+  out.start = std::move(s.w.out);
+  s.w.out.clear();
   out.relative_e_at_print = prog.at_print.relative_e, out.e_at_print = prog.at_print.e;
   out.fan_at_print = std::string(prog.fan_at_print);
   for (std::size_t k = prog.print_begin; k < prog.print_end; ++k)
@@ -246,8 +246,10 @@ Expected<ForeignGcode> map_foreign_gcode(std::string_view text, const LayerField
     const double z = prog.layer_z[lu];
     const auto cover = options.clip ? options.clip->cover(z) : LayerClip::Cover::all;
     i = j;
+    s.layer.clear();
     if (cover == LayerClip::Cover::none) {
-      write_dropped_layer(seq, s);
+      program::dropped_layer(seq, s.layer);
+      program::write_program_layer(s.w, s.layer);
       dropped[lu] = 1;
       continue;
     }
@@ -262,11 +264,13 @@ Expected<ForeignGcode> map_foreign_gcode(std::string_view text, const LayerField
     if (auto e = map_layer(work, field, params, options.planar_lines, out.layers[lu], points))
       return *e;
     program::order_top_skins(work, params.passes);
-    write_layer(work, field, params, options.planar_lines, prog.layer_height[lu], out.layers[lu],
+    build_layer(work, field, params, options.planar_lines, prog.layer_height[lu], out.layers[lu],
                 s);
+    program::write_program_layer(s.w, s.layer);
     if (ctx.cancelled()) return Error{Status::cancelled, "cancelled"};
   }
-  out.print_end = s.w.out.size();
+  out.print = std::move(s.w.out);
+  s.w.out.clear();
   out.end_at = s.at, out.retracted = s.retracted, out.relative_e_at_end = prog.at_end.relative_e;
   // The end G-code as written, after telling the firmware the file's own E (absolute E).
   if (prog.print_end < lines.size() && !prog.at_end.relative_e)
@@ -275,7 +279,7 @@ Expected<ForeignGcode> map_foreign_gcode(std::string_view text, const LayerField
     s.w.raw("G91 ; as the file had it here");
   for (; i < lines.size(); ++i) s.w.raw(lines[i].raw);
   if (s.w.fault) return *s.w.fault;
-  out.text = std::move(s.w.out);
+  out.end = std::move(s.w.out);
   for (std::size_t k = dropped.size(); k-- > 0;)
     if (dropped[k]) out.layers.erase(out.layers.begin() + static_cast<long>(k));
   return out;

@@ -52,7 +52,7 @@ Expected<EngineOutput> external(const TriangleMesh& to_slice, const LayerField* 
   }
   EngineOutput out;
   out.layers = std::move(mapped->layers);
-  out.gcode = std::move(mapped->text);
+  out.gcode = mapped->take_text();
   return out;
 }
 

@@ -150,12 +150,11 @@ Expected<EngineShell> shell_with_engine(const TriangleMesh& mesh, const layers::
     return e;
   }
 
-  // Stitch: the core's program up to its end G-code, the shell's print, the core's end.
+  // Stitch: the core's start and print, the shell's print, the core's end.
   EngineShell out;
-  const std::string& c = core->text;
-  const std::string& s = shell->text;
-  out.gcode.reserve(c.size() + s.size() + 256);
-  out.gcode.append(c, 0, core->print_end);
+  out.gcode.reserve(core->start.size() + core->print.size() + shell->print.size() +
+                    core->end.size() + 256);
+  out.gcode.append(core->start).append(core->print);
   out.gcode += "; nonplanar: the shell's curved layers, from the engine's second run\n";
   out.gcode += shell->relative_e_at_print ? "M83\n" : "M82\n";
   if (!shell->fan_at_print.empty()) out.gcode += shell->fan_at_print + "\n";
@@ -164,10 +163,10 @@ Expected<EngineShell> shell_with_engine(const TriangleMesh& mesh, const layers::
     std::snprintf(buf, sizeof buf, "G92 E%.5f\n", shell->e_at_print);
     out.gcode += buf;
   }
-  out.gcode.append(s, shell->print_begin, shell->print_end - shell->print_begin);
+  out.gcode.append(shell->print);
   out.gcode += "; nonplanar: the core run's end G-code\n";
   out.gcode += core->relative_e_at_end ? "M83\n" : "M82\n";
-  out.gcode.append(c, core->print_end, std::string::npos);
+  out.gcode.append(core->end);
   out.layers = std::move(core->layers);
   for (LayerToolpaths& L : shell->layers) out.layers.push_back(std::move(L));
   return out;

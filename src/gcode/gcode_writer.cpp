@@ -1,6 +1,7 @@
-// The G-code emitter: position, extrusion (absolute or relative), feed rate, retraction,
-// flavour; PrusaSlicer's preview annotations; no arcs. Text is built in memory and written
-// atomically, so a half-written file never exists under the final name.
+// The built-in engine's G-code: the start block, then each layer built as steps (LayerBuilder:
+// position, retraction, lifted travels, extrusion; PrusaSlicer's preview annotations; no arcs)
+// and written by the one writer (program/gcode_text.hpp), then the end block. Text is built in
+// memory and written atomically, so a half-written file never exists under the final name.
 #include <algorithm>
 #include <cctype>
 #include <cinttypes>
@@ -187,32 +188,31 @@ std::optional<Error> check_block_on_bed(const std::string& key, const std::strin
   return std::nullopt;
 }
 
-// The built-in engine's program, written through the one emitter (program/gcode_text.hpp):
-// travels with retraction and lift, extrusions, and the bed check on every point.
-class Emitter {
- public:
-  explicit Emitter(const PrintConfig& c)
-      : c_(c), g_(c.gcode), tip_radius_(c.toolhead.tip_radius), w_(c.gcode.relative_e) {}
-  /// The first point off the bed, or a line too long to format: the program is refused.
-  std::optional<Error> fault;
-  const char* what = "the print";  ///< what is being emitted, for the fault's message
+// The fan at `percent` as the flavour writes it.
+std::string fan_line(int percent, GcodeFlavor flavor) {
+  if (percent <= 0) return "M107";
+  char buf[32];
+  if (flavor == GcodeFlavor::reprapfirmware)
+    std::snprintf(buf, sizeof buf, "M106 S%.2f", percent / 100.0);
+  else
+    std::snprintf(buf, sizeof buf, "M106 S%d", static_cast<int>(std::lround(2.55 * percent)));
+  return buf;
+}
 
-  std::string& out() { return w_.out; }
-  const std::optional<Error>& format_fault() const { return w_.fault; }
-  void raw(const std::string& s) { w_.block(s); }
-  void comment(const std::string& s) { w_.raw(";" + s); }
-  template <class... A>
-  void line(const char* f, A... a) {
-    w_.line(f, a...);
-  }
-  void line(const char* s) { w_.raw(s); }
-  void fan(int percent) {
-    if (percent <= 0) return line("M107");
-    if (g_.flavor == GcodeFlavor::reprapfirmware) return line("M106 S%.2f", percent / 100.0);
-    line("M106 S%d", static_cast<int>(std::lround(2.55 * percent)));
-  }
+// The built-in engine's layers as steps (program.hpp), written by the one writer: travels
+// with retraction and lift, extrusions, and the bed check on every point. The nozzle's place
+// and the retraction carry over from one layer to the next.
+class LayerBuilder {
+ public:
+  explicit LayerBuilder(const PrintConfig& c)
+      : c_(c), g_(c.gcode), tip_radius_(c.toolhead.tip_radius) {}
+  /// The first point off the bed: the program is refused.
+  std::optional<Error> fault;
+  const char* what = "the print";  ///< what is being built, for the fault's message
+  ProgramLayer layer;              ///< the layer being built
+
   void reset_e() {
-    if (!g_.relative_e) line("G92 E0"), w_.set_e(0);
+    if (!g_.relative_e) layer.e_reset("G92 E0", 0);
   }
   void retract() {
     if (retracted_ || g_.retract_length <= 0) return;
@@ -238,7 +238,7 @@ class Emitter {
           travel_height(pos_, p, safe_z, slope, tip_radius_, travel_lift(g_.retract_lift));
       if (!std::isnan(lift)) {
         if (d > g_.retract_before_travel) retract();
-        program::lifted_travel(w_, pos_, p, lift, f, f);
+        layer.lifted_travel(pos_, p, lift, f, f);
         pos_ = p;
         return;
       }
@@ -247,6 +247,7 @@ class Emitter {
     if (!have_pos_) {
       // Wherever the start G-code left the nozzle, the way to the print is long: retract.
       retract();
+      layer.start(ProgramStep::Kind::travel);
       z_to(p, f), xy_to(p, f);
       pos_ = p, have_pos_ = true;
       return;
@@ -254,6 +255,7 @@ class Emitter {
     if (d < 1e-6 && std::abs(p.z() - pos_.z()) < 1e-6) return;
     const bool long_move = d > g_.retract_before_travel;
     if (long_move) retract();
+    layer.start(ProgramStep::Kind::travel);
     if (long_move && g_.retract_lift > 0)
       z_to(Vec3(p.x(), p.y(), std::max(pos_.z(), p.z()) + g_.retract_lift), f);
     else if (p.z() > pos_.z() + 1e-9)
@@ -262,12 +264,17 @@ class Emitter {
     if ((long_move && g_.retract_lift > 0) || p.z() < pos_.z() - 1e-9) z_to(p, f);
     pos_ = p;
   }
-  void extrude(const Vec3& p, double de, double speed) {
+  /// The next extrude() calls draw one path of this role and width.
+  void begin_path(ExtrusionRole role, double width) { role_ = role, width_ = width, fresh_ = true; }
+  void extrude(const Vec3& p, double de, double speed, double height) {
     check_on_bed(p, what);
     unretract();
-    program::MoveWords m;
-    m.xy = true, m.z = std::abs(p.z() - pos_.z()) > 1e-9, m.de = de, m.f = feed(speed);
-    w_.move(p, m);
+    if (fresh_ || layer.steps.empty() || layer.steps.back().kind != ProgramStep::Kind::extrusion)
+      layer.start(ProgramStep::Kind::extrusion, role_, width_), fresh_ = false;
+    ProgramMove m;
+    m.to = p, m.xy = true, m.z = std::abs(p.z() - pos_.z()) > 1e-9, m.de = de, m.f = feed(speed);
+    m.height = height;
+    layer.move(m);
     pos_ = p;
   }
 
@@ -275,19 +282,20 @@ class Emitter {
   // Feed rates are written as whole mm/min, truncated as they always were.
   static double feed(double mm_per_s) { return static_cast<int>(mm_per_s * 60); }
   void z_to(const Vec3& p, double f) {
-    program::MoveWords m;
-    m.z = true, m.f = f;
-    w_.move(p, m);
+    ProgramMove m;
+    m.to = p, m.z = true, m.f = f;
+    layer.move(m);
   }
   void xy_to(const Vec3& p, double f) {
-    program::MoveWords m;
-    m.xy = true, m.f = f;
-    w_.move(p, m);
+    ProgramMove m;
+    m.to = p, m.xy = true, m.f = f;
+    layer.move(m);
   }
   void move_e(double de, double speed, const char* why) {
-    program::MoveWords m;
-    m.de = de, m.f = feed(speed), m.comment = why;
-    w_.move(pos_, m);
+    layer.start(ProgramStep::Kind::retract);
+    ProgramMove m;
+    m.to = pos_, m.de = de, m.f = feed(speed), m.comment = why;
+    layer.move(m);
   }
   void check_on_bed(const Vec3& p, const char* kind) {
     if (fault || on_bed(p, c_)) return;
@@ -300,9 +308,11 @@ class Emitter {
   const PrintConfig& c_;
   const GcodeParams& g_;
   double tip_radius_;  ///< what a short hop must clear (travel_height)
-  program::GcodeText w_;
   Vec3 pos_ = Vec3::Zero();
   bool have_pos_ = false, retracted_ = false;
+  ExtrusionRole role_ = ExtrusionRole::perimeter;
+  double width_ = 0;
+  bool fresh_ = false;  ///< begin_path was called and nothing extruded since
 };
 
 }  // namespace
@@ -392,6 +402,70 @@ Expected<std::string> layer_block(const std::string& text, const char* key, Macr
 
 }  // namespace
 
+namespace {
+
+// The start block: our header, temperatures, modes, object labels, the start G-code.
+void write_start(program::GcodeText& w, const PrintConfig& c, const Blocks& blocks,
+                 const std::vector<std::string>& header, const std::string& labels) {
+  const GcodeParams& g = c.gcode;
+  w.raw("; generated by nonplanar 0.1.0");
+  for (const auto& h : header) w.raw(";" + (" " + h));
+  w.line(";FLAVOR:%s", flavor_name(g.flavor));
+  w.line("M140 S%g", g.first_layer_bed_temperature);
+  w.line("M104 S%g", g.first_layer_temperature);
+  if (!has_command(blocks.start, "M190")) w.line("M190 S%g", g.first_layer_bed_temperature);
+  if (!has_command(blocks.start, "M109")) w.line("M109 S%g", g.first_layer_temperature);
+  w.raw("G21 ; millimetres");
+  w.raw("G90 ; absolute XYZ");
+  w.raw(g.relative_e ? "M83 ; relative E" : "M82 ; absolute E");
+  w.block(labels);
+  // The start and end G-code are "Custom" moves, as PrusaSlicer marks them: its viewer shows
+  // the purge line so, and the reader's print ends at the last one.
+  w.raw(";TYPE:Custom");
+  w.block(blocks.start);
+  w.block(blocks.start_filament);
+  w.raw("G92 E0");
+}
+
+// Layer i's paths as steps (em.layer, after its custom blocks): each path travelled to, then
+// extruded, inside its object's label. Returns the filament pushed, mm.
+double build_paths(LayerBuilder& em, const LayerToolpaths& L, const PrintConfig& c,
+                   const gcode::ObjectLabels& labels) {
+  ProgramLayer& out = em.layer;
+  ExtrusionRole role = ExtrusionRole::skirt;
+  double width = -1, filament = 0;
+  bool first = true;
+  int labelled = -1;  // the object whose label this layer is inside (-1: none)
+  for (const ExtrusionPath& p : L.paths) {
+    if (p.points.size() < 2) continue;
+    if (labelled != p.object && p.role != ExtrusionRole::skirt) {
+      if (labelled >= 0) out.block(labels.stop(labelled));
+      out.block(labels.start(p.object)), labelled = p.object;
+    }
+    em.what = p.role == ExtrusionRole::skirt ? "the skirt" : "the print";
+    em.travel(p.points.front(), c.paths.travel_speed, L.nonplanar, L.max_z, L.max_slope);
+    if (first || p.role != role) out.line(";TYPE:%s", role_name(p.role));
+    if (first || std::abs(p.width - width) > 1e-9) out.line(";WIDTH:%.3f", p.width);
+    first = false;
+    role = p.role, width = p.width;
+    em.begin_path(p.role, p.width);
+    for (std::size_t k = 1; k < p.points.size(); ++k) {
+      const double len = (p.points[k] - p.points[k - 1]).norm();
+      if (len < 1e-6) continue;
+      // Each segment's own height sets its extrusion (non-planar paths vary).
+      const double h = 0.5 * (p.height[k] + p.height[k - 1]);
+      const double de = len * filament_per_mm(p.width, h, c.gcode);
+      filament += de;
+      em.extrude(p.points[k], de, p.speed, p.height[k]);
+    }
+  }
+  if (labelled >= 0) out.block(labels.stop(labelled));
+  em.retract();
+  return filament;
+}
+
+}  // namespace
+
 Expected<std::string> make_gcode(const std::vector<LayerToolpaths>& layers, const PrintConfig& c,
                                  const std::vector<std::string>& header, const Context& ctx) {
   ctx.progress("gcode", 0);
@@ -401,95 +475,57 @@ Expected<std::string> make_gcode(const std::vector<LayerToolpaths>& layers, cons
   if (!blocks) return blocks.error();
   MacroVariables layer_vars = block_variables(c, facts);
   double max_z = 0;
-  Emitter em(c);
+  program::GcodeText w(g.relative_e);
   // About 30 bytes a point, in room made once and backed by huge pages: the bunny's 67 MB
   // grew by doubling, each new buffer faulting in 4 KiB at a time.
   std::size_t points = 0;
   for (const LayerToolpaths& L : layers)
     for (const ExtrusionPath& p : L.paths) points += p.points.size();
-  em.out().reserve((std::size_t(1) << 20) + 32 * points);
-  advise_huge_pages(em.out().data(), em.out().capacity());
-  em.comment(" generated by nonplanar 0.1.0");
-  for (const auto& h : header) em.comment(" " + h);
-  em.line(";FLAVOR:%s", flavor_name(g.flavor));
-  em.line("M140 S%g", g.first_layer_bed_temperature);
-  em.line("M104 S%g", g.first_layer_temperature);
-  const std::string& start = blocks->start;
-  if (!has_command(start, "M190")) em.line("M190 S%g", g.first_layer_bed_temperature);
-  if (!has_command(start, "M109")) em.line("M109 S%g", g.first_layer_temperature);
-  em.line("G21 ; millimetres");
-  em.line("G90 ; absolute XYZ");
-  em.line(g.relative_e ? "M83 ; relative E" : "M82 ; absolute E");
+  w.out.reserve((std::size_t(1) << 20) + 32 * points);
+  advise_huge_pages(w.out.data(), w.out.capacity());
   const gcode::ObjectLabels labels = gcode::object_labels(c);
-  em.raw(labels.define(layers));
-  // The start and end G-code are "Custom" moves, as PrusaSlicer marks them: its viewer shows
-  // the purge line so, and the reader's print ends at the last one.
-  em.line(";TYPE:Custom");
-  em.raw(start);
-  em.raw(blocks->start_filament);
-  em.line("G92 E0");
+  write_start(w, c, *blocks, header, labels.define(layers));
+  // The layers, one at a time as steps.
+  LayerBuilder em(c);
+  ProgramLayer& out = em.layer;
   double filament = 0;
   for (std::size_t i = 0; i < layers.size(); ++i) {
     if (ctx.cancelled()) return Error{Status::cancelled, "cancelled"};
     const LayerToolpaths& L = layers[i];
-    em.comment("LAYER_CHANGE");
-    em.line(";Z:%.3f", L.z);
-    em.line(";HEIGHT:%.3f", L.height);
+    out.clear();
+    out.raw(";LAYER_CHANGE");
+    out.z_comment(L.z);
+    out.height_comment(L.height);
     auto before = layer_block(g.before_layer_gcode, "before_layer_gcode", layer_vars, i, L, max_z,
                               g.relative_e);
     if (!before) return before.error();
-    em.raw(*before);
+    out.block(*before);
     em.reset_e();
     auto after = layer_block(g.layer_gcode, "layer_gcode", layer_vars, i, L, max_z, g.relative_e);
     if (!after) return after.error();
-    em.raw(*after);
+    out.block(*after);
     if (i == 1) {
-      if (g.temperature != g.first_layer_temperature) em.line("M104 S%g", g.temperature);
+      if (g.temperature != g.first_layer_temperature) out.line("M104 S%g", g.temperature);
       if (g.bed_temperature != g.first_layer_bed_temperature)
-        em.line("M140 S%g", g.bed_temperature);
+        out.line("M140 S%g", g.bed_temperature);
     }
-    if (static_cast<int>(i) == g.disable_fan_first_layers) em.fan(g.fan_speed);
-    ExtrusionRole role = ExtrusionRole::skirt;
-    double width = -1;
-    bool first = true;
-    int labelled = -1;  // the object whose label this layer is inside (-1: none)
-    for (const ExtrusionPath& p : L.paths) {
-      if (p.points.size() < 2) continue;
-      if (labelled != p.object && p.role != ExtrusionRole::skirt) {
-        if (labelled >= 0) em.raw(labels.stop(labelled));
-        em.raw(labels.start(p.object)), labelled = p.object;
-      }
-      em.what = p.role == ExtrusionRole::skirt ? "the skirt" : "the print";
-      em.travel(p.points.front(), c.paths.travel_speed, L.nonplanar, L.max_z, L.max_slope);
-      if (first || p.role != role) em.line(";TYPE:%s", role_name(p.role));
-      if (first || std::abs(p.width - width) > 1e-9) em.line(";WIDTH:%.3f", p.width);
-      first = false;
-      role = p.role, width = p.width;
-      for (std::size_t k = 1; k < p.points.size(); ++k) {
-        const double len = (p.points[k] - p.points[k - 1]).norm();
-        if (len < 1e-6) continue;
-        // Each segment's own height sets its extrusion (non-planar paths vary).
-        const double h = 0.5 * (p.height[k] + p.height[k - 1]);
-        const double de = len * filament_per_mm(p.width, h, g);
-        filament += de;
-        em.extrude(p.points[k], de, p.speed);
-      }
-    }
-    if (labelled >= 0) em.raw(labels.stop(labelled));
-    em.retract();
+    if (static_cast<int>(i) == g.disable_fan_first_layers) out.raw(fan_line(g.fan_speed, g.flavor));
+    filament += build_paths(em, L, c, labels);
+    program::write_program_layer(w, out);
     ctx.progress("gcode", static_cast<double>(i + 1) / static_cast<double>(layers.size()));
   }
   if (em.fault) return *em.fault;
-  if (em.format_fault()) return *em.format_fault();
-  em.line(";TYPE:Custom");
-  em.fan(0);
-  em.raw(blocks->end_filament);
-  em.raw(blocks->end);
-  em.line("; filament used [mm] = %.2f", filament);
-  em.line("; filament used [cm3] = %.3f",
-          filament * M_PI * 0.25 * g.filament_diameter * g.filament_diameter / 1000.0);
-  if (em.format_fault()) return *em.format_fault();
-  return std::move(em.out());
+  if (w.fault) return *w.fault;
+  // The end block.
+  w.raw(";TYPE:Custom");
+  w.raw(fan_line(0, g.flavor));
+  w.block(blocks->end_filament);
+  w.block(blocks->end);
+  w.line("; filament used [mm] = %.2f", filament);
+  w.line("; filament used [cm3] = %.3f",
+         filament * M_PI * 0.25 * g.filament_diameter * g.filament_diameter / 1000.0);
+  if (w.fault) return *w.fault;
+  return std::move(w.out);
 }
 
 Expected<void> check_custom_gcode(const PrintConfig& c) {

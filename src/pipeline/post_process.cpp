@@ -324,7 +324,7 @@ Expected<PostProcessed> post_process_gcode(std::string_view gcode, const PrintPl
                 moved.x(), moved.y());
   std::string head = buf;
   for (const std::string& h : plan.header) head += "; " + h + "\n";
-  r.gcode = head + mapped->text;
+  r.gcode = head + mapped->take_text();
   std::string breach;
   auto ok = gate(
       r, job, dynamic_cast<const layers::BandedField*>(field->get()),

@@ -1,6 +1,8 @@
 // clip_layer (layer_passes.hpp): a planar layer cut back to where a margin is >= 0 (the
-// shell's core under the shell). s is the parameter along a move, 0 at its start, 1 at its end.
+// shell's core under the shell), and what is left of a layer cut away whole (dropped_layer).
+// s is the parameter along a move, 0 at its start, 1 at its end.
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <optional>
 
@@ -111,6 +113,19 @@ int clip_layer(LayerWork& w, const std::function<double(double, double)>& margin
   settle();
   w.lines = std::move(out);
   return 0;
+}
+
+void dropped_layer(const std::vector<GcodeLine>& lines, ProgramLayer& out) {
+  using Kind = GcodeLine::Kind;
+  for (const GcodeLine& it : lines)
+    if (it.kind == Kind::text || it.kind == Kind::e_mode)
+      if (!it.raw.empty() && std::toupper(static_cast<unsigned char>(it.raw[0])) == 'M' &&
+          it.raw.rfind("M106", 0) != 0 && it.raw.rfind("M107", 0) != 0) {
+        if (it.kind == Kind::e_mode)
+          out.e_mode(it.raw, it.value != 0);
+        else
+          out.raw(it.raw);
+      }
 }
 
 }  // namespace nonplanar::program

@@ -33,42 +33,59 @@ void GcodeText::line(const char* fmt, ...) {
   raw(buf);
 }
 
-void GcodeText::move(const Vec3& p, const MoveWords& w) {
+void GcodeText::move(const ProgramMove& m) {
   std::string s = "G1";
   bool fits = true;
-  if (w.xy) fits = word(s, 'X', p.x(), 3) && word(s, 'Y', p.y(), 3);
-  if (w.z) fits = fits && word(s, 'Z', p.z(), 3);
-  if (!std::isnan(w.de)) {
-    e_ += w.de;
-    fits = fits && word(s, 'E', rel_e_ ? w.de : e_, 5);
+  if (m.xy) fits = word(s, 'X', m.to.x(), 3) && word(s, 'Y', m.to.y(), 3);
+  if (m.z) fits = fits && word(s, 'Z', m.to.z(), 3);
+  if (!std::isnan(m.de)) {
+    e_ += m.de;
+    fits = fits && word(s, 'E', rel_e_ ? m.de : e_, 5);
   }
-  if (!std::isnan(w.f)) {
+  if (!std::isnan(m.f)) {
     char buf[32];
-    const double f = std::round(w.f);
+    const double f = std::round(m.f);
     fits = fits && std::abs(f) < 2e9;
     if (fits) std::snprintf(buf, sizeof buf, " F%d", static_cast<int>(f));
     if (fits) s += buf;
   }
-  if (w.comment) s += std::string(" ; ") + w.comment;
+  if (m.comment) s += std::string(" ; ") + m.comment;
   if ((!fits || s.size() > 255) && !fault)
     fault = Error{Status::internal_error, "a G-code line would not fit 255 characters"};
   raw(s);
 }
 
-void GcodeText::move_from(const Vec3& from, const Vec3& p, double de, double f) {
-  MoveWords w;
-  w.xy = std::abs(p.x() - from.x()) > 5e-4 || std::abs(p.y() - from.y()) > 5e-4;
-  w.z = std::abs(p.z() - from.z()) > 5e-4;
-  w.de = de, w.f = f;
-  if (w.xy || w.z || !std::isnan(de) || !std::isnan(f)) move(p, w);
-}
-
-void lifted_travel(GcodeText& w, const Vec3& at, const Vec3& to, double lift, double f_first,
-                   double f_rest, double de) {
-  const Vec3 up(at.x(), at.y(), lift), over(to.x(), to.y(), lift);
-  w.move_from(at, up, kNoValue, f_first);
-  w.move_from(up, over, kNoValue, f_rest);
-  w.move_from(over, to, de, f_rest);
+void write_program_layer(GcodeText& w, const ProgramLayer& layer) {
+  using Kind = ProgramStep::Kind;
+  if (layer.too_long && !w.fault)
+    w.fault = Error{Status::internal_error, "a G-code line would not fit 255 characters"};
+  for (const ProgramStep& s : layer.steps) {
+    const std::string_view bytes =
+        s.moves() ? std::string_view()
+                  : std::string_view(layer.text).substr(s.begin, s.end - s.begin);
+    switch (s.kind) {
+      case Kind::raw:
+        w.block(bytes);
+        break;
+      case Kind::z_comment:
+        w.line(";Z:%.3f", s.value);
+        break;
+      case Kind::height_comment:
+        w.line(";HEIGHT:%.3f", s.value);
+        break;
+      case Kind::e_reset:
+        w.block(bytes), w.set_e(s.value);
+        break;
+      case Kind::e_mode:
+        w.block(bytes), w.set_relative(s.value != 0);
+        break;
+      case Kind::travel:
+      case Kind::extrusion:
+      case Kind::retract:
+        for (std::uint32_t k = s.begin; k < s.end; ++k) w.move(layer.moves[k]);
+        break;
+    }
+  }
 }
 
 }  // namespace nonplanar::program

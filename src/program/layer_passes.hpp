@@ -55,4 +55,9 @@ void order_top_skins(LayerWork& layer, const LayerPassParams& p);
 int clip_layer(LayerWork& layer, const std::function<double(double x, double y)>& margin,
                const GcodeRetraction& ret, const LayerPassParams& p, std::size_t& samples);
 
+/// A layer the clip left nothing of, as steps (into `out`): only what it tells the printer
+/// (M-codes: temperatures, E mode); not the fan, which follows the layers printed instead (and
+/// is turned off at the end).
+void dropped_layer(const std::vector<GcodeLine>& lines, ProgramLayer& out);
+
 }  // namespace nonplanar::program

@@ -45,7 +45,7 @@ TEST(MapForeignGcode, PlanarFileOfTheNormalisedSaddlePrintsLikeTheBuiltInRoute) 
 
   auto mapped = map_foreign_gcode(*planar, *plan->field, {}, {});
   ASSERT_TRUE(mapped) << mapped.error().message;
-  const CheckFigures f = figures(mapped->text, mesh);
+  const CheckFigures f = figures(mapped->text(), mesh);
   EXPECT_LE(f.deviation_p95, 0.02);
   EXPECT_GT(f.covered_samples, 0.95 * static_cast<double>(f.surface_samples));
   EXPECT_EQ(f.collisions, 0u);
@@ -55,7 +55,7 @@ TEST(MapForeignGcode, PlanarFileOfTheNormalisedSaddlePrintsLikeTheBuiltInRoute) 
   EXPECT_NEAR(f.volume_ratio, 1.0, 0.03);
   // Top skins low to high (DESIGN.md §3): in each layer's top-skin run, every stroke
   // starts at its low end and no stroke lies lower than the one before it.
-  auto moves = read_gcode_moves(mapped->text);
+  auto moves = read_gcode_moves(mapped->text());
   ASSERT_TRUE(moves);
   std::size_t strokes = 0;
   int layer = -2;
@@ -127,20 +127,20 @@ TEST(MapForeignGcode, RefusesWhatItCannotMapNamingTheLine) {
   auto ok = map_foreign_gcode("M862.3 P \"MK3S\"\nG29 ; mesh\n" + head.substr(8) + "G92 E0\n",
                               *field, {}, {});
   ASSERT_TRUE(ok) << ok.error().message;
-  EXPECT_EQ(ok->text.rfind("M862.3 P \"MK3S\"\nG29 ; mesh\n", 0), 0u);
-  EXPECT_NE(ok->text.find("G1 X1.000 Y1.000 E1.00000"), std::string::npos) << ok->text;
+  EXPECT_EQ(ok->text().rfind("M862.3 P \"MK3S\"\nG29 ; mesh\n", 0), 0u);
+  EXPECT_NE(ok->text().find("G1 X1.000 Y1.000 E1.00000"), std::string::npos) << ok->text();
   // Relative XYZ inside the print is applied here: the mapped moves are absolute. G91 makes
   // E relative too (hostile input #4: read as absolute, it over-extruded 75x on a dome).
   auto rel = map_foreign_gcode(head + "G91\nG1 X2 Y1 E0.5\nG90\nG1 X5 E2\n", *field, {}, {});
   ASSERT_TRUE(rel) << rel.error().message;
-  EXPECT_NE(rel->text.find("G1 X3.000 Y2.000 E1.50000"), std::string::npos) << rel->text;
-  EXPECT_NE(rel->text.find("G1 X5.000 Y2.000 E2.00000"), std::string::npos) << rel->text;
-  EXPECT_EQ(rel->text.find("\nG91\n"), std::string::npos);
+  EXPECT_NE(rel->text().find("G1 X3.000 Y2.000 E1.50000"), std::string::npos) << rel->text();
+  EXPECT_NE(rel->text().find("G1 X5.000 Y2.000 E2.00000"), std::string::npos) << rel->text();
+  EXPECT_EQ(rel->text().find("\nG91\n"), std::string::npos);
   // M83 mid-print: the E that follows is relative, in the file and in what is written.
   auto m83 = map_foreign_gcode(head + "G1 X2 Y1 E2\nM83\nG1 X3 Y1 E0.5\nM82\nG1 X4 Y1 E3\n", *field,
                                {}, {});
   ASSERT_TRUE(m83) << m83.error().message;
-  const std::string& t = m83->text;
+  const std::string t = m83->text();
   EXPECT_NE(t.find("M83\nG1 X3.000 Y1.000 E0.50000"), std::string::npos) << t;
   EXPECT_NE(t.find("G1 X4.000 Y1.000 E3.00000"), std::string::npos) << t;
 }

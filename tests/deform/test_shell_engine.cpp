@@ -82,7 +82,7 @@ TEST(MapForeignGcode, ClipsLayersAndEntersFromAGivenStart) {
   o.start_retracted = 0.5;
   auto r = map_foreign_gcode(g, *field, {}, {}, o);
   ASSERT_TRUE(r) << r.error().message;
-  const std::string& t = r->text;
+  const std::string& t = r->text();
   // The kept piece extrudes its share; the rest is travel (6 mm, then the whole next move),
   // retracted once around both.
   EXPECT_NE(t.find("G1 X4.000 Y0.000 E0.40000 F1200\nG1 E-1.00000 F2400\nG1 X10.000 Y0.000 "
@@ -100,8 +100,10 @@ TEST(MapForeignGcode, ClipsLayersAndEntersFromAGivenStart) {
   EXPECT_NE(t.find(";HEIGHT:0.200\nG1 Z0.200 F600\nG1 X0.000 Y0.000 F6000\nG1 E-0.50000 F2400"),
             std::string::npos)
       << t;
-  EXPECT_EQ(t.substr(r->print_begin).rfind(";LAYER_CHANGE", 0), 0u);
-  EXPECT_EQ(t.substr(r->print_end), ";TYPE:Custom\nM107\nG28\n");
+  // The three blocks the shell route joins by.
+  EXPECT_EQ(r->start, "M83\nM106 S100\n");
+  EXPECT_EQ(r->print.rfind(";LAYER_CHANGE", 0), 0u);
+  EXPECT_EQ(r->end, ";TYPE:Custom\nM107\nG28\n");
   EXPECT_NEAR(r->retracted, 0.8, 1e-9);
   EXPECT_TRUE(r->end_at.isApprox(Vec3(10, 10, 0.2)));
   EXPECT_EQ(r->fan_at_print, "M106 S100");

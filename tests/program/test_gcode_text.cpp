@@ -19,10 +19,11 @@ std::string printf_move(double x, double y, double z, double e) {
 
 std::string written(double x, double y, double z, double e) {
   program::GcodeText w(true);
-  program::MoveWords words;
-  words.xy = words.z = true;
-  words.de = e;
-  w.move({x, y, z}, words);
+  ProgramMove m;
+  m.to = {x, y, z};
+  m.xy = m.z = true;
+  m.de = e;
+  w.move(m);
   EXPECT_FALSE(w.fault);
   return w.out;
 }

@@ -100,9 +100,9 @@ TEST(ReadProgram, StockPrusaAndKlipperLinesPassAsText) {
   const auto field = planar_field({});
   auto mapped = map_foreign_gcode(text, *field, {}, {});
   ASSERT_TRUE(mapped) << mapped.error().message;
-  EXPECT_NE(mapped->text.find("EXCLUDE_OBJECT_START NAME=cube_id_0_copy_0\n"), std::string::npos);
-  EXPECT_NE(mapped->text.find("M862.3 P \"MK3S\""), std::string::npos);
-  EXPECT_NE(mapped->text.find("\nprint_layer_done\n"), std::string::npos);
+  EXPECT_NE(mapped->text().find("EXCLUDE_OBJECT_START NAME=cube_id_0_copy_0\n"), std::string::npos);
+  EXPECT_NE(mapped->text().find("M862.3 P \"MK3S\""), std::string::npos);
+  EXPECT_NE(mapped->text().find("\nprint_layer_done\n"), std::string::npos);
 }
 
 TEST(ReadProgram, ProblemsNameTheirLines) {
@@ -163,25 +163,59 @@ TEST(ReadProgram, EachBeadKeepsItsOwnThickness) {
 
 TEST(GcodeText, WritesTheWordsAskedForAndKeepsE) {
   program::GcodeText abs(false, 1.0);
-  program::MoveWords w;
-  w.xy = true, w.de = 0.5, w.f = 1799.6;
-  abs.move(Vec3(1.23456, 2, 0.2), w);
-  w.xy = false, w.z = true, w.de = -0.8, w.f = kNoValue, w.comment = "retract";
-  abs.move(Vec3(1, 2, 0.3), w);
+  ProgramMove m;
+  m.to = Vec3(1.23456, 2, 0.2), m.xy = true, m.de = 0.5, m.f = 1799.6;
+  abs.move(m);
+  m.to = Vec3(1, 2, 0.3), m.xy = false, m.z = true, m.de = -0.8, m.f = kNoValue;
+  m.comment = "retract";
+  abs.move(m);
   EXPECT_EQ(abs.out, "G1 X1.235 Y2.000 E1.50000 F1800\nG1 Z0.300 E0.70000 ; retract\n");
-  program::GcodeText rel(true);
-  rel.move_from(Vec3(0, 0, 0.2), Vec3(0.0004, 0, 0.2), 0.1, kNoValue);  // under 0.5 µm: no XY
-  rel.move_from(Vec3(0, 0, 0.2), Vec3(0, 0, 0.2), kNoValue, kNoValue);  // nothing to write
-  rel.move_from(Vec3(0, 0, 0.2), Vec3(3, 0, 0.2), 0.2, kNoValue);
-  EXPECT_EQ(rel.out, "G1 E0.10000\nG1 X3.000 Y0.000 E0.20000\n");
-  EXPECT_FALSE(rel.fault);
   // A number no printer takes does not fit a line: the program is refused, not truncated.
-  w.z = false, w.xy = true, w.de = 1e300, w.comment = nullptr;
-  rel.move(Vec3(1, 1, 1), w);
+  program::GcodeText rel(true);
+  m.z = false, m.xy = true, m.de = 1e300, m.comment = nullptr;
+  rel.move(m);
   ASSERT_TRUE(rel.fault);
-  program::GcodeText lift;
-  program::lifted_travel(lift, Vec3(0, 0, 1), Vec3(5, 0, 1.2), 1.6, 9000, kNoValue);
-  EXPECT_EQ(lift.out, "G1 Z1.600 F9000\nG1 X5.000 Y0.000\nG1 Z1.200\n");
+}
+
+// A layer as steps (program.hpp), written by the one writer: each step's lines in order, E
+// followed across the steps that set it, values filled in after the moves.
+TEST(ProgramLayer, StepsAreWrittenInOrderAndFollowE) {
+  using StepKind = ProgramStep::Kind;
+  ProgramLayer L;
+  L.raw(";LAYER_CHANGE");
+  const std::size_t z = L.z_comment(0);
+  L.e_mode("M83", true);
+  L.start(StepKind::extrusion, ExtrusionRole::top_solid_infill, 0.42);
+  L.move_from(Vec3(0, 0, 0.2), Vec3(0.0004, 0, 0.2), 0.1, kNoValue);  // under 0.5 µm: no XY
+  L.move_from(Vec3(0, 0, 0.2), Vec3(0, 0, 0.2), kNoValue, kNoValue);  // nothing to write
+  L.move_from(Vec3(0, 0, 0.2), Vec3(3, 0, 0.25), 0.2, kNoValue, 0.25);
+  L.lifted_travel(Vec3(3, 0, 0.25), Vec3(5, 0, 1.2), 1.6, 9000, kNoValue);
+  L.e_mode("M82", false);
+  L.e_reset("G92 E5", 5);
+  L.start(StepKind::retract);
+  L.move_from(Vec3(5, 0, 1.2), Vec3(5, 0, 1.2), -0.8, 2100);
+  L.block("M104 S200\nM140 S60\n");
+  L.steps[z].value = 0.25;
+  ASSERT_EQ(L.steps.size(), 9u);
+  EXPECT_EQ(L.steps[3].kind, StepKind::extrusion);
+  EXPECT_EQ(L.steps[3].end - L.steps[3].begin, 2u);
+  EXPECT_EQ(L.steps[3].role, ExtrusionRole::top_solid_infill);
+  EXPECT_DOUBLE_EQ(L.moves[1].height, 0.25);
+  EXPECT_EQ(L.steps[4].kind, StepKind::travel);
+  EXPECT_EQ(L.steps[4].end - L.steps[4].begin, 3u);
+  program::GcodeText w(false, 2.0);
+  program::write_program_layer(w, L);
+  EXPECT_EQ(w.out,
+            ";LAYER_CHANGE\n;Z:0.250\nM83\nG1 E0.10000\nG1 X3.000 Y0.000 Z0.250 E0.20000\n"
+            "G1 Z1.600 F9000\nG1 X5.000 Y0.000\nG1 Z1.200\nM82\nG92 E5\nG1 E4.20000 F2100\n"
+            "M104 S200\nM140 S60\n");
+  EXPECT_FALSE(w.fault);
+  // A line too long to send refuses the layer when it is written.
+  L.clear();
+  L.line(";%s", std::string(300, 'x').c_str());
+  program::GcodeText refused;
+  program::write_program_layer(refused, L);
+  EXPECT_TRUE(refused.fault);
 }
 
 }  // namespace
