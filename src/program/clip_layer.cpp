@@ -116,12 +116,11 @@ int clip_layer(LayerWork& w, const std::function<double(double, double)>& margin
 }
 
 void dropped_layer(const std::vector<GcodeLine>& lines, ProgramLayer& out) {
-  using Kind = GcodeLine::Kind;
   for (const GcodeLine& it : lines)
-    if (it.kind == Kind::text || it.kind == Kind::e_mode)
+    if (it.kind == GcodeLine::Kind::text || it.kind == GcodeLine::Kind::e_mode)
       if (!it.raw.empty() && std::toupper(static_cast<unsigned char>(it.raw[0])) == 'M' &&
           it.raw.rfind("M106", 0) != 0 && it.raw.rfind("M107", 0) != 0) {
-        if (it.kind == Kind::e_mode)
+        if (it.kind == GcodeLine::Kind::e_mode)
           out.e_mode(it.raw, it.value != 0);
         else
           out.raw(it.raw);

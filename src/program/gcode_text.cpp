@@ -56,7 +56,7 @@ void GcodeText::move(const ProgramMove& m) {
 }
 
 void write_program_layer(GcodeText& w, const ProgramLayer& layer) {
-  using Kind = ProgramStep::Kind;
+  using StepKind = ProgramStep::Kind;
   if (layer.too_long && !w.fault)
     w.fault = Error{Status::internal_error, "a G-code line would not fit 255 characters"};
   for (const ProgramStep& s : layer.steps) {
@@ -64,24 +64,24 @@ void write_program_layer(GcodeText& w, const ProgramLayer& layer) {
         s.moves() ? std::string_view()
                   : std::string_view(layer.text).substr(s.begin, s.end - s.begin);
     switch (s.kind) {
-      case Kind::raw:
+      case StepKind::raw:
         w.block(bytes);
         break;
-      case Kind::z_comment:
+      case StepKind::z_comment:
         w.line(";Z:%.3f", s.value);
         break;
-      case Kind::height_comment:
+      case StepKind::height_comment:
         w.line(";HEIGHT:%.3f", s.value);
         break;
-      case Kind::e_reset:
+      case StepKind::e_reset:
         w.block(bytes), w.set_e(s.value);
         break;
-      case Kind::e_mode:
+      case StepKind::e_mode:
         w.block(bytes), w.set_relative(s.value != 0);
         break;
-      case Kind::travel:
-      case Kind::extrusion:
-      case Kind::retract:
+      case StepKind::travel:
+      case StepKind::extrusion:
+      case StepKind::retract:
         for (std::uint32_t k = s.begin; k < s.end; ++k) w.move(layer.moves[k]);
         break;
     }

@@ -7,14 +7,14 @@
 
 namespace nonplanar {
 
-using Kind = ProgramStep::Kind;
+using StepKind = ProgramStep::Kind;
 
 void ProgramLayer::clear() {
   steps.clear(), moves.clear(), text.clear();
   too_long = false;
 }
 
-void ProgramLayer::text_step(Kind kind, std::string_view bytes, double value) {
+void ProgramLayer::text_step(StepKind kind, std::string_view bytes, double value) {
   ProgramStep s;
   s.kind = kind;
   s.begin = static_cast<std::uint32_t>(text.size());
@@ -25,13 +25,13 @@ void ProgramLayer::text_step(Kind kind, std::string_view bytes, double value) {
 }
 
 void ProgramLayer::raw(std::string_view line) {
-  text_step(Kind::raw, line, 0);
+  text_step(StepKind::raw, line, 0);
   text.push_back('\n');
   steps.back().end = static_cast<std::uint32_t>(text.size());
 }
 
 void ProgramLayer::block(std::string_view lines) {
-  if (!lines.empty()) text_step(Kind::raw, lines, 0);
+  if (!lines.empty()) text_step(StepKind::raw, lines, 0);
 }
 
 void ProgramLayer::line(const char* fmt, ...) {
@@ -45,26 +45,26 @@ void ProgramLayer::line(const char* fmt, ...) {
 }
 
 std::size_t ProgramLayer::z_comment(double z) {
-  steps.push_back(ProgramStep{Kind::z_comment, 0, 0, z});
+  steps.push_back(ProgramStep{StepKind::z_comment, 0, 0, z});
   return steps.size() - 1;
 }
 
 std::size_t ProgramLayer::height_comment(double h) {
-  steps.push_back(ProgramStep{Kind::height_comment, 0, 0, h});
+  steps.push_back(ProgramStep{StepKind::height_comment, 0, 0, h});
   return steps.size() - 1;
 }
 
 void ProgramLayer::e_reset(std::string_view line, double e) {
   raw(line);
-  steps.back().kind = Kind::e_reset, steps.back().value = e;
+  steps.back().kind = StepKind::e_reset, steps.back().value = e;
 }
 
 void ProgramLayer::e_mode(std::string_view line, bool relative) {
   raw(line);
-  steps.back().kind = Kind::e_mode, steps.back().value = relative ? 1 : 0;
+  steps.back().kind = StepKind::e_mode, steps.back().value = relative ? 1 : 0;
 }
 
-void ProgramLayer::start(Kind kind, ExtrusionRole role, double width) {
+void ProgramLayer::start(StepKind kind, ExtrusionRole role, double width) {
   ProgramStep s;
   s.kind = kind;
   s.begin = s.end = static_cast<std::uint32_t>(moves.size());
@@ -73,7 +73,7 @@ void ProgramLayer::start(Kind kind, ExtrusionRole role, double width) {
 }
 
 void ProgramLayer::move(const ProgramMove& m) {
-  if (steps.empty() || !steps.back().moves()) start(Kind::travel);
+  if (steps.empty() || !steps.back().moves()) start(StepKind::travel);
   moves.push_back(m);
   steps.back().end = static_cast<std::uint32_t>(moves.size());
 }
@@ -88,7 +88,7 @@ void ProgramLayer::move_from(const Vec3& from, const Vec3& p, double de, double 
 
 void ProgramLayer::lifted_travel(const Vec3& at, const Vec3& to, double lift, double f_first,
                                  double f_rest, double de) {
-  start(Kind::travel);
+  start(StepKind::travel);
   const Vec3 up(at.x(), at.y(), lift), over(to.x(), to.y(), lift);
   move_from(at, up, kNoValue, f_first);
   move_from(up, over, kNoValue, f_rest);
