@@ -57,6 +57,29 @@ TEST(NormalizeMesh, FacesOutsideTheCareBoxStayWholeAndTheMeshConforms) {
     EXPECT_LT(cared->mesh.vertices[v].x(), 1.5);
   // Closed and conforming: each edge between two faces.
   for (const auto& [edge, n] : edge_uses(cared->mesh)) EXPECT_EQ(n, 2);
+  for (const auto& [edge, n] : edge_uses(whole->mesh)) EXPECT_EQ(n, 2);
+}
+
+// The face limit is checked before a round is built, on the count the round would leave: a
+// limit of exactly the result's size passes, one face fewer is refused.
+TEST(NormalizeMesh, TheFaceLimitIsTheCountTheRoundsWouldLeave) {
+  const TriangleMesh sphere = test::icosphere(Vec3(0, 0, 8), 9, 2);
+  const layers::ShellPlan plan = bump_plan();  // the field keeps a reference to it
+  const layers::ShellField field(plan);
+  auto whole = normalize_mesh(sphere, field, {}, {});
+  ASSERT_TRUE(whole);
+  ASSERT_GT(whole->rounds, 1);
+  NormalizeParams exact;
+  exact.max_faces = whole->mesh.faces.size();
+  auto fits = normalize_mesh(sphere, field, exact, {});
+  ASSERT_TRUE(fits) << fits.error().message;
+  EXPECT_EQ(fits->mesh.faces, whole->mesh.faces);
+  NormalizeParams fewer = exact;
+  --fewer.max_faces;
+  auto refused = normalize_mesh(sphere, field, fewer, {});
+  ASSERT_FALSE(refused);
+  EXPECT_EQ(refused.error().status, Status::unsupported);
+  EXPECT_NE(refused.error().message.find("more than"), std::string::npos);
 }
 
 }  // namespace
