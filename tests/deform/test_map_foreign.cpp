@@ -45,7 +45,8 @@ TEST(MapForeignGcode, PlanarFileOfTheNormalisedSaddlePrintsLikeTheBuiltInRoute) 
 
   auto mapped = map_foreign_gcode(*planar, *plan->field, {}, {});
   ASSERT_TRUE(mapped) << mapped.error().message;
-  const CheckFigures f = figures(mapped->text(), mesh);
+  const std::string mapped_text = mapped->text();  // the moves read below view it
+  const CheckFigures f = figures(mapped_text, mesh);
   EXPECT_LE(f.deviation_p95, 0.02);
   EXPECT_GT(f.covered_samples, 0.95 * static_cast<double>(f.surface_samples));
   EXPECT_EQ(f.collisions, 0u);
@@ -55,7 +56,7 @@ TEST(MapForeignGcode, PlanarFileOfTheNormalisedSaddlePrintsLikeTheBuiltInRoute) 
   EXPECT_NEAR(f.volume_ratio, 1.0, 0.03);
   // Top skins low to high (DESIGN.md §3): in each layer's top-skin run, every stroke
   // starts at its low end and no stroke lies lower than the one before it.
-  auto moves = read_gcode_moves(mapped->text());
+  auto moves = read_gcode_moves(mapped_text);
   ASSERT_TRUE(moves);
   std::size_t strokes = 0;
   int layer = -2;

@@ -82,7 +82,7 @@ TEST(MapForeignGcode, ClipsLayersAndEntersFromAGivenStart) {
   o.start_retracted = 0.5;
   auto r = map_foreign_gcode(g, *field, {}, {}, o);
   ASSERT_TRUE(r) << r.error().message;
-  const std::string& t = r->text();
+  const std::string t = r->text();
   // The kept piece extrudes its share; the rest is travel (6 mm, then the whole next move),
   // retracted once around both.
   EXPECT_NE(t.find("G1 X4.000 Y0.000 E0.40000 F1200\nG1 E-1.00000 F2400\nG1 X10.000 Y0.000 "
