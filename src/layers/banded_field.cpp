@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "nurbs/bspline_basis.hpp"
 
@@ -237,16 +238,20 @@ double BandedField::T(double x, double y, double z) const {
   return t;
 }
 
+namespace {
+constexpr double kNoHint = std::numeric_limits<double>::quiet_NaN();  ///< z_at: no root below
+}  // namespace
+
 double BandedField::z_at(double x, double y, double t) const {
-  return z_at(Column(*this, x, y), t);
+  return z_at(Column(*this, x, y), t, kNoHint, 1e-10);
 }
 
 void BandedField::z_at(double x, double y, const double* t, double* z, int n) const {
   const Column col(*this, x, y);
-  for (int i = 0; i < n; ++i) z[i] = z_at(col, t[i]);
+  for (int i = 0; i < n; ++i) z[i] = z_at(col, t[i], kNoHint, 1e-10);
 }
 
-double BandedField::z_at(const Column& col, double t) const {
+double BandedField::z_at(const Column& col, double t, double lo_hint, double tol) const {
   // Closed forms first: where no band reaches, T is planar; where exactly one band has β = 1
   // (on its patch), T inside the stack is T_bottom + N − s with s the fractional surface
   // index, so z interpolates the two surfaces around s. Everywhere else, root-find.
@@ -262,15 +267,15 @@ double BandedField::z_at(const Column& col, double t) const {
       return Si + f * (only->surface(*basis, i + 1) - Si);
     }
   }
-  // T increases in z: bracket around the planar guess, then bisection with a secant step
-  // (Illinois) to 1e-10 mm.
+  // T increases in z: bracket around the planar guess (from lo_hint when given: a root below
+  // this one), then bisection with a secant step (Illinois) to tol.
   const double z0 = pl_.zeta(t);
-  double lo = z0 - 1.0, hi = z0 + 1.0;
+  double lo = std::isnan(lo_hint) ? z0 - 1.0 : lo_hint, hi = std::max(z0, lo) + 1.0;
   double flo = col.T(lo) - t, fhi = col.T(hi) - t;
   for (int k = 0; flo > 0 && k < 60; ++k) lo -= (hi - lo), flo = col.T(lo) - t;
   for (int k = 0; fhi < 0 && k < 60; ++k) hi += (hi - lo), fhi = col.T(hi) - t;
   int side = 0;
-  for (int it = 0; it < 200 && hi - lo > 1e-10; ++it) {
+  for (int it = 0; it < 200 && hi - lo > tol; ++it) {
     double z = (lo * fhi - hi * flo) / (fhi - flo);
     if (!(z > lo && z < hi)) z = 0.5 * (lo + hi);
     const double f = col.T(z) - t;
@@ -286,6 +291,13 @@ double BandedField::z_at(const Column& col, double t) const {
     }
   }
   return 0.5 * (lo + hi);
+}
+
+void BandedField::z_column(double x, double y, const double* t, double* z, int n,
+                           double tol) const {
+  const Column col(*this, x, y);
+  for (int i = 0; i < n; ++i)
+    z[i] = z_at(col, t[i], i > 0 && t[i] >= t[i - 1] ? z[i - 1] : kNoHint, tol);
 }
 
 double BandedField::thickness(double x, double y, double z) const {

@@ -78,6 +78,10 @@ class BandedField final : public LayerField {
   bool planar_along(const Vec2& a, const Vec2& b, double t_lo, double t_hi) const override;
   const std::vector<Band>& bands() const { return bands_; }
   const PlanarLayers& planar() const { return pl_; }
+  /// z_at for n layer coordinates t[0..n), increasing, on one vertical line, each within tol
+  /// (mm) of the exact root; each bracket starts from the root below it. For a check over
+  /// many columns of many layers (check_blend in plan_layers.cpp), where 1e-10 mm is not needed.
+  void z_column(double x, double y, const double* t, double* z, int n, double tol) const;
   /// Where a band can bend the layers: β > 0 only inside [lo, hi] (XY), and the layers only
   /// between c and z_top (its top's highest point over that box, plus its fade), i.e. for
   /// layer coordinates in (T_bottom, t_top).
@@ -92,7 +96,8 @@ class BandedField final : public LayerField {
   /// or a difference quotient evaluates them once (the sum keeps T's order of terms, so the
   /// value is bit-identical to T(x, y, z)).
   class Column;
-  double z_at(const Column& col, double t) const;
+  /// lo_hint: a z where T <= t (NaN: none); tol: the bracket's width to stop at, mm.
+  double z_at(const Column& col, double t, double lo_hint, double tol) const;
   PlanarLayers pl_;
   std::vector<Band> bands_;
   std::vector<Reach> reach_;  ///< per band

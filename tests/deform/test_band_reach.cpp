@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "nonplanar/deform.hpp"
 #include "nonplanar/pipeline.hpp"
@@ -37,6 +38,38 @@ struct DomeOnSlab {
     field = dynamic_cast<const layers::BandedField*>(r.plan.field.get());
   }
 };
+
+// The blend check's columns (BandedField::z_column: each root bracketed from the one below,
+// to a given tolerance) against the field's own roots, through the dome's blend zone.
+TEST(BandedField, AColumnsRootsAreTheFieldsWithinTheTolerance) {
+  const DomeOnSlab d;
+  ASSERT_NE(d.field, nullptr);
+  ASSERT_EQ(d.field->bands().size(), 1u);
+  const layers::Band& b = d.field->bands()[0];
+  std::vector<double> t;
+  for (int k = static_cast<int>(b.T_bottom); k <= static_cast<int>(b.T_bottom) + b.N + 10; ++k)
+    t.push_back(k);
+  int columns = 0;
+  double worst = 0;
+  for (int i = 0; i < b.blend_nx; i += 3)
+    for (int j = 0; j < b.blend_ny; j += 3) {
+      const double x = b.blend_origin.x() + i * b.blend_cell,
+                   y = b.blend_origin.y() + j * b.blend_cell;
+      const double beta = b.beta(x, y);
+      if (beta <= 0.05 || beta >= 0.95) continue;
+      ++columns;
+      std::vector<double> z(t.size());
+      d.field->z_column(x, y, t.data(), z.data(), static_cast<int>(t.size()), 1e-7);
+      for (std::size_t k = 0; k < t.size(); ++k) {
+        worst = std::max(worst, std::abs(z[k] - d.field->z_at(x, y, t[k])));
+        if (k > 0) {
+          EXPECT_GT(z[k], z[k - 1]);
+        }
+      }
+    }
+  EXPECT_GT(columns, 20);
+  EXPECT_LE(worst, 1e-7);
+}
 
 TEST(GateZones, FindEveryCollisionTheFullCheckFinds) {
   const DomeOnSlab d;
