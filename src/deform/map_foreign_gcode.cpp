@@ -220,7 +220,9 @@ Expected<ForeignGcode> map_foreign_gcode(std::string_view text, const LayerField
   ForeignGcode out;
   out.layers.resize(prog.layer_height.size());
   Writing s{GcodeText(prog.at_print.relative_e, prog.at_print.e)};
-  std::vector<ExtrusionPath> mapped(prog.moves.size());
+  std::vector<ExtrusionPath> mapped;  // as much room as the moves (the passes add to both)
+  mapped.reserve(prog.moves.capacity());
+  mapped.resize(prog.moves.size());
   std::size_t i = 0;
   for (; i < prog.print_begin; ++i) s.w.raw(lines[i].raw);
   out.start = std::move(s.w.out);
