@@ -80,8 +80,8 @@ std::optional<Error> map_layer(LayerWork& work, const LayerField& field,
 // An extrusion or wipe (a travel step, retracting as it goes), one G1 per mapped piece; an
 // extrusion also goes into the gate's path (L.paths[*run], started when *run < 0). Adds the
 // layer thicknesses written to h_sum, h_n.
-void write_pieces(const GcodeMove& m, const ExtrusionPath& p, LayerToolpaths& L, long& run,
-                  Writing& s, double& h_sum, std::size_t& h_n) {
+void add_pieces(const GcodeMove& m, const ExtrusionPath& p, LayerToolpaths& L, long& run,
+                Writing& s, double& h_sum, std::size_t& h_n) {
   const double lp = (m.to - m.from).norm();
   double l3 = 0;
   for (std::size_t q = 1; q < p.points.size(); ++q) l3 += (p.points[q] - p.points[q - 1]).norm();
@@ -125,8 +125,8 @@ void write_pieces(const GcodeMove& m, const ExtrusionPath& p, LayerToolpaths& L,
 // A retraction, or a travel (or a Z move) to the target's place on its layer, lifted over
 // curved layers. A Z move stays where the nozzle is (not where the file's start G-code left
 // it, when the caller moved the start).
-void write_travel(const GcodeMove& m, const LayerField& field, const MapBackParams& params,
-                  const LayerToolpaths& L, bool keep, Writing& s) {
+void add_travel(const GcodeMove& m, const LayerField& field, const MapBackParams& params,
+                const LayerToolpaths& L, bool keep, Writing& s) {
   if (!m.has_xy && !m.has_z) {  // retraction, F only
     if (m.has_e) s.retracted -= m.de;
     s.layer.start(ProgramStep::Kind::retract);
@@ -190,11 +190,11 @@ void build_layer(const LayerWork& work, const LayerField& field, const MapBackPa
     const GcodeMove& m = work.moves[static_cast<std::size_t>(it.move)];
     const ExtrusionPath& p = work.mapped[static_cast<std::size_t>(it.move)];
     if (!p.points.empty()) {
-      write_pieces(m, p, L, run, s, h_sum, h_n);
+      add_pieces(m, p, L, run, s, h_sum, h_n);
       continue;
     }
     run = -1;
-    write_travel(m, field, params, L, kept(planar_lines, m), s);
+    add_travel(m, field, params, L, kept(planar_lines, m), s);
   }
   for (const std::size_t k : z_steps) s.layer.steps[k].value = L.max_z;
   for (const std::size_t k : h_steps)

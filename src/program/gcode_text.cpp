@@ -22,14 +22,22 @@ bool word(std::string& s, char letter, double v, int digits) {
 
 }  // namespace
 
+bool format_line(char (&buf)[256], const char* fmt, va_list ap) {
+  const int n = std::vsnprintf(buf, sizeof buf, fmt, ap);
+  return n >= 0 && n < static_cast<int>(sizeof buf);
+}
+
+Error line_too_long() {
+  return Error{Status::internal_error, "a G-code line would not fit 255 characters"};
+}
+
 void GcodeText::line(const char* fmt, ...) {
   char buf[256];
   va_list ap;
   va_start(ap, fmt);
-  const int n = std::vsnprintf(buf, sizeof buf, fmt, ap);
+  const bool fits = format_line(buf, fmt, ap);
   va_end(ap);
-  if ((n < 0 || n >= static_cast<int>(sizeof buf)) && !fault)
-    fault = Error{Status::internal_error, "a G-code line would not fit 255 characters"};
+  if (!fits && !fault) fault = line_too_long();
   raw(buf);
 }
 
@@ -50,15 +58,13 @@ void GcodeText::move(const ProgramMove& m) {
     if (fits) s += buf;
   }
   if (m.comment) s += std::string(" ; ") + m.comment;
-  if ((!fits || s.size() > 255) && !fault)
-    fault = Error{Status::internal_error, "a G-code line would not fit 255 characters"};
+  if ((!fits || s.size() > 255) && !fault) fault = line_too_long();
   raw(s);
 }
 
 void write_program_layer(GcodeText& w, const ProgramLayer& layer) {
   using StepKind = ProgramStep::Kind;
-  if (layer.too_long && !w.fault)
-    w.fault = Error{Status::internal_error, "a G-code line would not fit 255 characters"};
+  if (layer.too_long && !w.fault) w.fault = line_too_long();
   for (const ProgramStep& s : layer.steps) {
     const std::string_view bytes =
         s.moves() ? std::string_view()

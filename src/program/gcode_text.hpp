@@ -4,6 +4,7 @@
 // same on every route. Units: mm, mm of filament, feed rates in mm/min (written as integers).
 #pragma once
 
+#include <cstdarg>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -41,6 +42,12 @@ class GcodeText {
   bool rel_e_;
   double e_;
 };
+
+/// vsnprintf into one line of at most 255 characters: false when it does not fit (the line is
+/// cut, and the program must be refused with line_too_long()).
+bool format_line(char (&buf)[256], const char* fmt, va_list ap)
+    __attribute__((format(printf, 2, 0)));
+Error line_too_long();
 
 /// Writes one layer's steps, in order, and follows its E changes (a too_long layer sets
 /// w.fault).

@@ -1,9 +1,9 @@
 // ProgramLayer (program.hpp): one layer of a program as steps, as an engine builds it.
 #include <cmath>
 #include <cstdarg>
-#include <cstdio>
 
 #include "nonplanar/program.hpp"
+#include "program/gcode_text.hpp"
 
 namespace nonplanar {
 
@@ -38,9 +38,8 @@ void ProgramLayer::line(const char* fmt, ...) {
   char buf[256];
   va_list ap;
   va_start(ap, fmt);
-  const int n = std::vsnprintf(buf, sizeof buf, fmt, ap);
+  too_long |= !program::format_line(buf, fmt, ap);
   va_end(ap);
-  if (n < 0 || n >= static_cast<int>(sizeof buf)) too_long = true;
   raw(buf);
 }
 
