@@ -9,14 +9,6 @@
 namespace nonplanar {
 namespace {
 
-// Points on the G-code's 1 µm grid (%.3f), before anything measures or writes them.
-EngineOutput on_file_grid(EngineOutput out) {
-  for (LayerToolpaths& layer : out.layers)
-    for (ExtrusionPath& p : layer.paths)
-      for (Vec3& v : p.points) v = (v * 1000.0).array().round() / 1000.0;
-  return out;
-}
-
 Expected<EngineOutput> builtin(const TriangleMesh& to_slice, const LayerField* field,
                                const EngineRoute& route, const Context& ctx) {
   auto sliced = slice_mesh(to_slice, route.print.slice, ctx);
@@ -60,10 +52,8 @@ Expected<EngineOutput> external(const TriangleMesh& to_slice, const LayerField* 
 
 Expected<EngineOutput> slice_with(const TriangleMesh& to_slice, const LayerField* field,
                                   const EngineRoute& route, const Context& ctx) {
-  auto out = route.engine.engine == Engine::builtin ? builtin(to_slice, field, route, ctx)
-                                                    : external(to_slice, field, route, ctx);
-  if (!out) return out;
-  return on_file_grid(std::move(*out));
+  return route.engine.engine == Engine::builtin ? builtin(to_slice, field, route, ctx)
+                                                : external(to_slice, field, route, ctx);
 }
 
 Expected<EngineOutput> shell_with(const TriangleMesh& mesh,
@@ -83,7 +73,7 @@ Expected<EngineOutput> shell_with(const TriangleMesh& mesh,
     out.layers = std::move(printed->layers);
     out.gcode = std::move(printed->gcode);
   }
-  return on_file_grid(std::move(out));
+  return out;
 }
 
 std::string engine_header(const EngineRoute& route, const std::vector<std::string>& header,

@@ -32,8 +32,8 @@ struct EngineOutput {
 
 /// Inputs: the mesh to slice (the normalised one, or the placed mesh when nothing is
 /// curved), the plan's field (null: nothing is curved, the layers are kept as sliced).
-/// Output: the built-in engine's layers, or the external engine's program mapped back; every
-/// point on the 1 µm grid the G-code holds (%.3f), so the gate's slopes are the file's.
+/// Output: the built-in engine's layers, or the external engine's program mapped back (its
+/// layers as mapped, for the gate's thickness check and zones; slopes are judged on the text).
 /// Errors: those of the stages and of the engine (the message names it), cancelled.
 Expected<EngineOutput> slice_with(const TriangleMesh& to_slice, const LayerField* field,
                                   const EngineRoute& route, const Context& ctx);

@@ -56,7 +56,8 @@ PrintFacts facts_of(const std::vector<LayerToolpaths>& layers, const PrintConfig
   Vec2 lo(1e300, 1e300), hi(-1e300, -1e300);
   for (const ExtrusionPath& p : layers.front().paths) {
     if (p.role == ExtrusionRole::skirt) continue;
-    for (const Vec3& q : p.points) {  // the bead's outer edge, as PrusaSlicer's slice outline
+    for (const Vec3& v : p.points) {  // the bead's outer edge, as PrusaSlicer's slice outline
+      const Vec3 q = program::on_file_grid(v);
       lo = lo.cwiseMin(q.head<2>() - Vec2::Constant(0.5 * p.width));
       hi = hi.cwiseMax(q.head<2>() + Vec2::Constant(0.5 * p.width));
       any = true;
@@ -443,20 +444,25 @@ double build_paths(LayerBuilder& em, const LayerToolpaths& L, const PrintConfig&
       out.block(labels.start(p.object)), labelled = p.object;
     }
     em.what = p.role == ExtrusionRole::skirt ? "the skirt" : "the print";
-    em.travel(p.points.front(), c.paths.travel_speed, L.nonplanar, L.max_z, L.max_slope);
+    em.travel(program::on_file_grid(p.points.front()), c.paths.travel_speed, L.nonplanar, L.max_z,
+              L.max_slope);
     if (first || p.role != role) out.line(";TYPE:%s", role_name(p.role));
     if (first || std::abs(p.width - width) > 1e-9) out.line(";WIDTH:%.3f", p.width);
     first = false;
     role = p.role, width = p.width;
     em.begin_path(p.role, p.width);
+    // Points as the file holds them: E follows the length written.
+    Vec3 from = program::on_file_grid(p.points.front());
     for (std::size_t k = 1; k < p.points.size(); ++k) {
-      const double len = (p.points[k] - p.points[k - 1]).norm();
+      const Vec3 to = program::on_file_grid(p.points[k]);
+      const double len = (to - from).norm();
       if (len < 1e-6) continue;
       // Each segment's own height sets its extrusion (non-planar paths vary).
       const double h = 0.5 * (p.height[k] + p.height[k - 1]);
       const double de = len * filament_per_mm(p.width, h, c.gcode);
       filament += de;
-      em.extrude(p.points[k], de, p.speed, p.height[k]);
+      em.extrude(to, de, p.speed, p.height[k]);
+      from = to;
     }
   }
   if (labelled >= 0) out.block(labels.stop(labelled));

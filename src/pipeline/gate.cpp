@@ -7,6 +7,8 @@
 
 #include "core/parallel.hpp"
 #include "nonplanar/gcode.hpp"
+#include "nonplanar/program.hpp"
+#include "nonplanar/toolpaths.hpp"
 #include "pipeline/gate_zones.hpp"
 
 namespace nonplanar {
@@ -43,30 +45,21 @@ Expected<void> write_program(SliceResult& r, const SliceJob& job, const Context&
 
 namespace {
 
-// Thickness within [h_min, h_max] and slope within max_angle on the paths (their points on
-// the file's µm grid, engine_route.hpp), each with g's slack; fills r's thickness and
-// steepest figures.
-bool limits(SliceResult& r, const LayerParams& L, const GateParams& g, const Violation& violation) {
+// Thickness within [h_min, h_max] on the paths, with g's slack (the file holds no per-point
+// thickness; the paths' heights are the ones the extrusion was computed from); fills r's
+// thickness figures.
+bool thickness(SliceResult& r, const LayerParams& L, const GateParams& g,
+               const Violation& violation) {
   r.thickness_min = 1e300, r.thickness_max = 0;
-  const double tan_max = std::tan((L.max_angle_deg + g.angle_slack_deg) * M_PI / 180.0);
-  for (std::size_t li = 0; li < r.layers.size(); ++li)
+  for (std::size_t li = 1; li < r.layers.size(); ++li)
     for (const ExtrusionPath& p : r.layers[li].paths) {
       if (p.role == ExtrusionRole::skirt) continue;
       for (std::size_t k = 0; k < p.points.size(); ++k) {
-        if (li > 0) {
-          r.thickness_min = std::min(r.thickness_min, p.height[k]);
-          r.thickness_max = std::max(r.thickness_max, p.height[k]);
-          if ((p.height[k] < L.min_layer_height - g.thickness_slack ||
-               p.height[k] > L.max_layer_height + g.thickness_slack) &&
-              !violation(p.points[k], "a layer leaves the thickness limits"))
-            return false;
-        }
-        if (k == 0) continue;
-        const double dxy = (p.points[k] - p.points[k - 1]).head<2>().norm();
-        const double dz = std::abs(p.points[k].z() - p.points[k - 1].z());
-        if (dxy <= g.slope_run) continue;
-        r.steepest_deg = std::max(r.steepest_deg, std::atan2(dz, dxy) * 180 / M_PI);
-        if (dz > tan_max * dxy && !violation(p.points[k], "an extrusion is steeper than max_angle"))
+        r.thickness_min = std::min(r.thickness_min, p.height[k]);
+        r.thickness_max = std::max(r.thickness_max, p.height[k]);
+        if ((p.height[k] < L.min_layer_height - g.thickness_slack ||
+             p.height[k] > L.max_layer_height + g.thickness_slack) &&
+            !violation(p.points[k], "a layer leaves the thickness limits"))
           return false;
       }
     }
@@ -74,17 +67,41 @@ bool limits(SliceResult& r, const LayerParams& L, const GateParams& g, const Vio
   return true;
 }
 
+// Slope within max_angle (with g's slack) on the extrusions of the program about to be
+// written, read back from r.gcode: the coordinates the printer gets, not the paths they were
+// rounded from. Only the print's own lines count: not the skirt, and not custom blocks (the
+// user's start G-code, before any ;TYPE: or under "Custom"). Fills r.steepest_deg.
+bool slopes(SliceResult& r, const LayerParams& L, const GateParams& g, const Violation& violation) {
+  const double tan_max = std::tan((L.max_angle_deg + g.angle_slack_deg) * M_PI / 180.0);
+  double steepest = 0;
+  bool go_on = true;
+  for_each_gcode_move(r.gcode, [&](const GcodeMove& m) {
+    if (!go_on || m.layer < 0 || !m.extruding() || m.type.empty() || m.type == "Custom" ||
+        role_from_name(m.type) == ExtrusionRole::skirt)
+      return;
+    const double dxy = (m.to - m.from).head<2>().norm();
+    const double dz = std::abs(m.to.z() - m.from.z());
+    if (dxy <= g.slope_run) return;
+    steepest = std::max(steepest, dz / dxy);
+    if (dz > tan_max * dxy) go_on = violation(m.to, "an extrusion is steeper than max_angle");
+  });
+  r.steepest_deg = std::max(r.steepest_deg, std::atan(steepest) * 180 / M_PI);
+  return go_on;
+}
+
 }  // namespace
 
 Expected<bool> gate(SliceResult& r, const SliceJob& job, const layers::BandedField* banded,
                     const Violation& violation, const Context& ctx) {
   ctx.progress("gate", 0);
-  if (!limits(r, job.layers, job.gate, violation)) return false;
+  if (!thickness(r, job.layers, job.gate, violation)) return false;
+  if (auto w = write_program(r, job, ctx); !w) return w.error();
+  ctx.progress("gate", 0);
+  if (!slopes(r, job.layers, job.gate, violation)) return false;
   if (!r.nonplanar) return true;  // planar layers cannot dig into earlier ones
   // Collisions: in the program about to be written, read back as `check` reads the file, so
   // the two agree to the last digit. They are looked for even when bands already broke a
   // limit, so one retry drops every offender (each retry replans, reslices and rechecks).
-  if (auto w = write_program(r, job, ctx); !w) return w.error();
   // The file's time and filament (with_print_stats' reading), measured on the other core
   // while this one searches: on the bunny each took about 0.9 s. Kept when this program is
   // the one written (r.stats_in_gcode).

@@ -4,6 +4,7 @@
 // same on every route. Units: mm, mm of filament, feed rates in mm/min (written as integers).
 #pragma once
 
+#include <cmath>
 #include <cstdarg>
 #include <optional>
 #include <string>
@@ -42,6 +43,13 @@ class GcodeText {
   bool rel_e_;
   double e_;
 };
+
+/// p as the file holds it: each coordinate rounded to the µm, as move() writes it (%.3f). A
+/// writer that derives numbers from positions (E from a segment's length, the first layer's
+/// footprint) takes them from here, so they agree with the coordinates written.
+inline Vec3 on_file_grid(const Vec3& p) {
+  return (p * 1000.0).array().round() / 1000.0;
+}
 
 /// vsnprintf into one line of at most 255 characters: false when it does not fit (the line is
 /// cut, and the program must be refused with line_too_long()).

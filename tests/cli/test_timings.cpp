@@ -26,11 +26,12 @@ TEST(Timings, EveryStageOfACurvedSliceIsTimedAndTheSpansAddUp) {
     order.push_back((*it)[1]);
     sum += std::stod((*it)[2]);
   }
-  // The gate checks the limits, writes the program, then looks for collisions in it while
-  // the other core measures the file's time and filament (no "stats" span of its own).
-  const std::vector<std::string> want = {"load",      "analyze", "fit",        "layers",
-                                         "normalize", "slice",   "toolpaths",  "map back",
-                                         "gate",      "gcode",   "collisions", "write"};
+  // The gate checks the thickness, writes the program, checks its slopes, then looks for
+  // collisions in it while the other core measures the file's time and filament (no "stats"
+  // span of its own).
+  const std::vector<std::string> want = {"load",  "analyze",    "fit",      "layers", "normalize",
+                                         "slice", "toolpaths",  "map back", "gate",   "gcode",
+                                         "gate",  "collisions", "write"};
   EXPECT_EQ(order, want) << r.err;
   std::smatch m;
   ASSERT_TRUE(std::regex_search(r.err, m, std::regex(R"(setup ([0-9.]+), total ([0-9.]+))")))

@@ -2,6 +2,7 @@
 // collisions only at the heights printed out of order (gate_zones.hpp's out_of_order).
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <string>
 
 #include "pipeline/gate.hpp"
@@ -110,6 +111,37 @@ TEST(Gate, FindsACollisionWithAShellPiecePrintedEarlierWithoutBands) {
   EXPECT_EQ(what, "an extrusion would hit earlier layers");
   what.clear();
   EXPECT_TRUE(run(160, &what)) << what;  // 40 mm away, beyond the heater block
+}
+
+// A program as another slicer's route hands it over: the slope limit is judged on the lines
+// written, the print's own only. The user's start block and the skirt climb steeply and do not
+// count; a perimeter that climbs 2 mm over 4 mm (26.57°) is within 30°, one that climbs 2 mm
+// over 1.5 mm (53.13°) is not, and the breach is reported at the line's end.
+TEST(Gate, JudgesSlopesOnTheProgramWritten) {
+  const SliceJob job = make_job(PrintConfig{});
+  auto run = [&](double run_x, Vec3* where, SliceResult* r) {
+    r->gcode =
+        "G90\nM82\nG92 E0\n;TYPE:Custom\nG1 X10 Y10 Z0.3 F3000\nG1 X12 Y10 Z3 E1\n"
+        ";LAYER_CHANGE\n;Z:0.2\n;HEIGHT:0.2\n;TYPE:Skirt/Brim\nG1 X30 Y10 Z0.2\n"
+        "G1 X32 Y10 Z2 E2\n;TYPE:External perimeter\nG1 X40 Y10 Z0.2\nG1 X" +
+        std::to_string(40 + run_x) + " Y10 Z2.2 E3\n";
+    auto ok = gate(*r, job, nullptr,
+                   [&](const Vec3& p, const char* w) {
+                     EXPECT_STREQ(w, "an extrusion is steeper than max_angle");
+                     *where = p;
+                     return false;
+                   },
+                   {});
+    EXPECT_TRUE(ok) << ok.error().message;
+    return ok && *ok;
+  };
+  Vec3 where(0, 0, 0);
+  SliceResult gentle;
+  EXPECT_TRUE(run(4, &where, &gentle));
+  EXPECT_NEAR(gentle.steepest_deg, std::atan2(2.0, 4.0) * 180 / M_PI, 1e-9);
+  SliceResult steep;
+  EXPECT_FALSE(run(1.5, &where, &steep));
+  EXPECT_NEAR((where - Vec3(41.5, 10, 2.2)).norm(), 0, 1e-9);
 }
 
 }  // namespace
