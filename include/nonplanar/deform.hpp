@@ -2,6 +2,7 @@
 // layers become planar, (x, y, z) ↦ (x, y, ζ(T(x, y, z))), subdividing where the map bends.
 #pragma once
 
+#include <limits>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -91,6 +92,12 @@ class LayerClip {
   virtual Cover cover(double z) const = 0;
   /// Continuous in x, y; >= 0 where the layer with top z is kept (mm).
   virtual double margin(double x, double y, double z) const = 0;
+  /// At least |∇margin(·, ·, z)| anywhere in the box [lo, hi] (mm per mm); infinity (the
+  /// default) when not known, and every move is then looked at step by step.
+  virtual double slope_bound(const Vec2& lo, const Vec2& hi, double z) const {
+    (void)lo, (void)hi, (void)z;
+    return std::numeric_limits<double>::infinity();
+  }
 };
 
 struct ForeignMapOptions {

@@ -257,8 +257,11 @@ Expected<ForeignGcode> map_foreign_gcode(std::string_view text, const LayerField
     }
     if (cover == LayerClip::Cover::some) {
       auto margin = [&](double x, double y) { return options.clip->margin(x, y, z); };
-      if (const int bad =
-              program::clip_layer(work, margin, prog.retraction, params.passes, clip_samples))
+      auto bound = [&](const Vec2& lo, const Vec2& hi) {
+        return options.clip->slope_bound(lo, hi, z);
+      };
+      if (const int bad = program::clip_layer(work, margin, bound, prog.retraction, params.passes,
+                                              clip_samples))
         return Error{Status::invalid_argument, "line " + std::to_string(bad) + ": more than " +
                                                    std::to_string(params.passes.most_clip_samples) +
                                                    " clip samples"};

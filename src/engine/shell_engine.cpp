@@ -21,9 +21,13 @@ namespace {
 // wing's 27° side that entered the core by 0.12 mm, over the collision test's h / 2.
 class CoreClip final : public LayerClip {
  public:
-  CoreClip(const layers::ShellPlan& p, double inset) : p_(p), inset_(inset) {
+  CoreClip(const layers::ShellPlan& p, double inset) : p_(p), inset_(inset), slopes_(p.top) {
     const auto [lo, hi] = std::minmax_element(p.top.h.begin(), p.top.h.end());
     lo_ = *lo, hi_ = *hi;
+    for (int k = 0; k < 8; ++k) {
+      const double a = k * M_PI / 4;
+      around_[static_cast<std::size_t>(k)] = Vec2(inset_ * std::cos(a), inset_ * std::sin(a));
+    }
   }
   Cover cover(double z) const override {
     const double level = p_.core_level(z);
@@ -32,16 +36,19 @@ class CoreClip final : public LayerClip {
   // The least over the point and 8 around it at the inset: continuous, as the clip needs.
   double margin(double x, double y, double z) const override {
     double h = p_.top.height(x, y);
-    for (int k = 0; k < 8; ++k) {
-      const double a = k * M_PI / 4;
-      h = std::min(h, p_.top.height(x + inset_ * std::cos(a), y + inset_ * std::sin(a)));
-    }
+    for (const Vec2& o : around_) h = std::min(h, p_.top.height(x + o.x(), y + o.y()));
     return h - p_.core_level(z);
+  }
+  // The least of H at 9 points is no steeper than H over the box they sweep.
+  double slope_bound(const Vec2& lo, const Vec2& hi, double) const override {
+    return slopes_.over(lo - Vec2::Constant(inset_), hi + Vec2::Constant(inset_));
   }
 
  private:
   const layers::ShellPlan& p_;
   double inset_ = 0;
+  layers::TopSlopeBound slopes_;
+  std::array<Vec2, 8> around_;  ///< the 8 points at the inset, from the centre
   double lo_ = 0, hi_ = 0;
 };
 
@@ -100,12 +107,14 @@ Expected<EngineShell> shell_with_engine(const TriangleMesh& mesh, const layers::
   // real top, so the shell counts as their cover), each layer cut back under the shell.
   EngineRun core_run;
   core_run.layer_tops.assign(plan.core.begin() + 1, plan.core.end());
+  ctx.progress("engine", 0);
   auto core_text = run_engine(job.engine, mesh, job.print, ctx, core_run);
   if (!core_text) return core_text.error();
   const CoreClip clip(plan, 0.5 * job.print.paths.perimeter_width);
   ForeignMapOptions core_opt;
   core_opt.clip = &clip;
   const auto planar = planar_field(job.layers);
+  ctx.progress("map back", 0);
   auto core = map_foreign_gcode(*core_text, *planar, job.map_back, ctx, core_opt);
   if (!core) {
     Error e = core.error();
@@ -132,14 +141,17 @@ Expected<EngineShell> shell_with_engine(const TriangleMesh& mesh, const layers::
   // (Not beside the core's run: write_file_atomically registers one temporary at a time for
   // the signal handler, and both runs write their mesh through it.)
   const layers::ShellField field(plan);
+  ctx.progress("normalize", 0);
   auto normalized = normalize_mesh(mesh, field, shell_normalize_params(mesh), ctx);
   if (!normalized) return normalized.error();
   EngineRun shell_run;
   shell_run.slab_layer_height = plan.t;
+  ctx.progress("engine", 0);
   auto shell_text =
       run_engine(job.engine, cut_below(normalized->mesh, 0.0), job.print, ctx, shell_run);
   if (!shell_text) return shell_text.error();
   const layers::ShellPathField path_field(plan);
+  ctx.progress("map back", 0);
   ForeignMapOptions shell_opt;
   shell_opt.start = core->end_at;
   shell_opt.start_retracted = core->retracted;

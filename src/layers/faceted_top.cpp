@@ -78,6 +78,42 @@ Vec2 FacetedTop::gradient(double x, double y) const {
           ((1 - u) * (p[1] - p[0]) + u * (p[ny + 1] - p[ny])) / cell};
 }
 
+TopSlopeBound::TopSlopeBound(const FacetedTop& t)
+    : origin_(t.origin), cell_(t.cell), nx_(t.nx), ny_(t.ny) {
+  if (nx_ < 2 || ny_ < 2 || t.h.size() != static_cast<std::size_t>(nx_) * ny_) return;
+  tx_ = (nx_ - 2) / kTile + 1, ty_ = (ny_ - 2) / kTile + 1;
+  max_.assign(static_cast<std::size_t>(tx_) * ty_, 0.0);
+  const auto at = [&](int i, int j) { return t.h[static_cast<std::size_t>(i) * ny_ + j]; };
+  for (int i = 0; i + 1 < nx_; ++i)
+    for (int j = 0; j + 1 < ny_; ++j) {
+      const double p00 = at(i, j), p01 = at(i, j + 1), p10 = at(i + 1, j), p11 = at(i + 1, j + 1);
+      const double gx = std::max(std::abs(p10 - p00), std::abs(p11 - p01));
+      const double gy = std::max(std::abs(p01 - p00), std::abs(p11 - p10));
+      const bool finite = std::isfinite(p00 + p01 + p10 + p11);
+      const double g =
+          finite ? std::hypot(gx, gy) / cell_ : std::numeric_limits<double>::infinity();
+      double& tile = max_[static_cast<std::size_t>(i / kTile) * ty_ + j / kTile];
+      tile = std::max(tile, g);
+    }
+}
+
+double TopSlopeBound::over(const Vec2& lo, const Vec2& hi) const {
+  if (max_.empty()) return std::numeric_limits<double>::infinity();
+  // The cells locate() would use for the box's corners, and every cell between.
+  auto cell_of = [&](double v, double o, int n) {
+    const double f = std::clamp((v - o) / cell_, 0.0, n - 1.0);
+    return std::clamp(static_cast<int>(std::floor(f)), 0, n - 2);
+  };
+  const int i0 = cell_of(lo.x(), origin_.x(), nx_) / kTile;
+  const int i1 = cell_of(hi.x(), origin_.x(), nx_) / kTile;
+  const int j0 = cell_of(lo.y(), origin_.y(), ny_) / kTile;
+  const int j1 = cell_of(hi.y(), origin_.y(), ny_) / kTile;
+  double g = 0;
+  for (int i = i0; i <= i1; ++i)
+    for (int j = j0; j <= j1; ++j) g = std::max(g, max_[static_cast<std::size_t>(i) * ty_ + j]);
+  return g;
+}
+
 FacetedTop faceted_top(const TriangleMesh& mesh, const Patch& patch, double cell, double pad,
                        double max_slope) {
   FacetedTop t;

@@ -33,6 +33,27 @@ struct FacetedTop {
   Vec2 gradient(double x, double y) const;
 };
 
+/// A bound on H's slope over boxes, for a caller that can skip the points where it cannot
+/// change sign. Within a cell the bilinear interpolant's ∂H/∂x is a mix of the cell's two
+/// x-edge differences over the spacing (∂H/∂y likewise), so |∇H| there is at most the hypot of
+/// the larger of each; kept as the largest over tiles of 16 × 16 cells.
+class TopSlopeBound {
+ public:
+  explicit TopSlopeBound(const FacetedTop& t);
+  /// At least |∇H| anywhere in the box [lo, hi] (mm per mm; past the raster's edge H is
+  /// constant outward, as height() is); infinity for a raster with no cells or a node not
+  /// finite.
+  double over(const Vec2& lo, const Vec2& hi) const;
+
+ private:
+  static constexpr int kTile = 16;
+  Vec2 origin_{0, 0};
+  double cell_ = 1;
+  int nx_ = 0, ny_ = 0;      ///< nodes, as the top's
+  int tx_ = 0, ty_ = 0;      ///< tiles along x and y
+  std::vector<double> max_;  ///< per tile (index i·ty + j), mm per mm
+};
+
 /// H on a raster of `cell` mm (coarser for huge patches: at most about 2 million nodes)
 /// covering the patch's XY box grown by `pad` mm. Nodes inside a patch triangle (in XY) take
 /// that triangle's height; the first ring outside continues its neighbours' triangles'

@@ -51,8 +51,12 @@ void order_top_skins(LayerWork& layer, const LayerPassParams& p);
 /// the file's own retraction) when longer than p.clip_retract_over. Crossings are found on
 /// p.clip_step steps and bisected. `samples` counts the margins looked up; past
 /// p.most_clip_samples it stops and returns the line it was on (else 0). Runs before mapping:
-/// `mapped` entries of new moves are empty.
+/// `mapped` entries of new moves are empty. slope_bound(lo, hi), when given, is at least
+/// |∇margin| anywhere in the box [lo, hi] (mm per mm): a move whose margin at its start is
+/// farther from 0 than that slope can take it over its length is kept or cut whole without
+/// its steps being looked at (the steps would all have said the same).
 int clip_layer(LayerWork& layer, const std::function<double(double x, double y)>& margin,
+               const std::function<double(const Vec2& lo, const Vec2& hi)>& slope_bound,
                const GcodeRetraction& ret, const LayerPassParams& p, std::size_t& samples);
 
 /// A layer the clip left nothing of, as steps (into `out`): only what it tells the printer

@@ -2,6 +2,8 @@
 // from the normalised mesh, and the core's layers cut back (map_foreign_gcode's clip).
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <map>
 
 #include "engine/shell_engine.hpp"
@@ -108,6 +110,55 @@ TEST(MapForeignGcode, ClipsLayersAndEntersFromAGivenStart) {
   EXPECT_TRUE(r->end_at.isApprox(Vec3(10, 10, 0.2)));
   EXPECT_EQ(r->fan_at_print, "M106 S100");
   EXPECT_TRUE(r->relative_e_at_print);
+}
+
+// Keeps where a zigzag is over 0: margin 1.5 − |x mod 8 − 4| + 0.05·y, as steep along x as
+// its bound, hypot(1, 0.05), allows (a step skipped too many would cross a cut); counts the
+// margins looked up. With the bound told, moves are cut exactly where they are without it,
+// from far fewer margins (a third: each cut still takes 30 to bisect).
+class Zigzag final : public LayerClip {
+ public:
+  explicit Zigzag(bool tell) : tell_(tell) {}
+  Cover cover(double) const override { return Cover::some; }
+  double margin(double x, double y, double) const override {
+    ++looked;
+    return 1.5 - std::abs(std::fmod(x + 100, 8.0) - 4) + 0.05 * y;
+  }
+  double slope_bound(const Vec2& lo, const Vec2& hi, double z) const override {
+    return tell_ ? std::hypot(1.0, 0.05) : LayerClip::slope_bound(lo, hi, z);
+  }
+  mutable long looked = 0;
+
+ private:
+  bool tell_;
+};
+
+TEST(MapForeignGcode, AClipsSlopeBoundSkipsStepsNotCuts) {
+  // Infill lines across the zigzag, 30 mm long, 0.45 mm apart, on two layers.
+  std::string g = "M83\n";
+  for (int layer = 0; layer < 2; ++layer) {
+    const double z = 0.2 * (layer + 1);
+    g += ";LAYER_CHANGE\n;Z:" + std::to_string(z) + "\n;HEIGHT:0.2\nG1 Z" + std::to_string(z) +
+         " F600\nG1 X0 Y0 F6000\n;TYPE:Internal infill\n";
+    for (int k = 0; k < 20; ++k) {
+      const double y = 0.45 * k;
+      g += "G1 X" + std::to_string(k % 2 ? 0 : 30) + " Y" + std::to_string(y) + " E1 F1200\n";
+      g += "G1 X" + std::to_string(k % 2 ? 0 : 30) + " Y" + std::to_string(y + 0.45) + " E0.02\n";
+    }
+  }
+  const auto field = planar_field({});
+  auto run = [&](const Zigzag& clip) {
+    ForeignMapOptions o;
+    o.clip = &clip;
+    auto r = map_foreign_gcode(g, *field, {}, {}, o);
+    EXPECT_TRUE(r) << r.error().message;
+    return r ? r->text() : std::string();
+  };
+  const Zigzag every_step(false), bounded(true);
+  const std::string a = run(every_step), b = run(bounded);
+  EXPECT_TRUE(a == b);                                   // (not EXPECT_EQ: 20 kB of text)
+  EXPECT_GT(std::count(a.begin(), a.end(), '\n'), 200);  // cut many times over
+  EXPECT_LT(bounded.looked * 2, every_step.looked) << bounded.looked << " " << every_step.looked;
 }
 
 }  // namespace

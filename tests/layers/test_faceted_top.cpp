@@ -94,5 +94,40 @@ TEST(FacetSamples, ExactHeightsAndSlopesOnTheFacets) {
   EXPECT_NEAR(fs.h_hi, patch.z_max, 1e-12);
 }
 
+// The slope bound holds on the cap's top between random nearby points (H's change over a
+// step is at most the bound over the step's box times its length), is exact on a plane, and
+// is 0 over a flat tile beside a steep one.
+TEST(TopSlopeBound, BoundsTheTopsChangeAndIsTightOnAPlane) {
+  const Cap cap;
+  const layers::FacetedTop ft = layers::faceted_top(cap.mesh, cap.patch(), 0.1, 3.0, 0.3);
+  const layers::TopSlopeBound bound(ft);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(0, 1), d(-2, 2);
+  const Vec2 size(ft.cell * (ft.nx - 1), ft.cell * (ft.ny - 1));
+  for (int k = 0; k < 20000; ++k) {
+    const Vec2 p = ft.origin + Vec2(u(rng) * size.x(), u(rng) * size.y());
+    const Vec2 q = p + Vec2(d(rng), d(rng));
+    const double L = bound.over(p.cwiseMin(q), p.cwiseMax(q));
+    ASSERT_LE(std::abs(ft.height(q.x(), q.y()) - ft.height(p.x(), p.y())),
+              L * (q - p).norm() + 1e-12)
+        << p.transpose() << " -> " << q.transpose();
+  }
+  layers::FacetedTop plane;
+  plane.cell = 0.5, plane.nx = 40, plane.ny = 40;  // 20 mm, tiles of 8 mm
+  for (int i = 0; i < plane.nx; ++i)
+    for (int j = 0; j < plane.ny; ++j)
+      plane.h.push_back(i < 32 ? 0.3 * i * plane.cell + 0.4 * j * plane.cell : 1e3);
+  const layers::TopSlopeBound on_plane(plane);
+  EXPECT_NEAR(on_plane.over({1, 1}, {3, 3}), 0.5, 1e-12);
+  EXPECT_GT(on_plane.over({1, 1}, {19, 3}), 100);  // the cliff at x = 15.5-16 mm
+  plane.h.assign(plane.h.size(), 2.0);
+  plane.h.back() = 50;  // one node, in the last tile
+  const layers::TopSlopeBound flat(plane);
+  EXPECT_EQ(flat.over({0, 0}, {7, 7}), 0.0);
+  EXPECT_GT(flat.over({0, 0}, {30, 30}), 90);  // past the edge: the edge's cells
+  plane.h[5] = std::nan("");
+  EXPECT_TRUE(std::isinf(layers::TopSlopeBound(plane).over({0, 0}, {1, 1})));
+}
+
 }  // namespace
 }  // namespace nonplanar
