@@ -14,20 +14,31 @@
 
 namespace nonplanar {
 namespace {
-// The temporary being written, for remove_pending_temporary_file(). A fixed buffer, published
-// through an atomic flag, because a signal handler may read it at any moment.
-char g_pending[4096];
-std::atomic<bool> g_pending_set{false};
+// The temporaries being written, for remove_pending_temporary_file(): a few slots (a shell's
+// two engine runs write their meshes side by side), each a fixed buffer published through an
+// atomic state, because a signal handler may read them at any moment.
+constexpr int kPendingSlots = 4;
+enum : int { kFree = 0, kFilling = 1, kSet = 2 };
+char g_pending[kPendingSlots][4096];
+std::atomic<int> g_pending_state[kPendingSlots]{};
 
 struct PendingGuard {
   explicit PendingGuard(const std::string& path) {
-    if (path.size() >= sizeof g_pending) return;  // too long to register: not removable early
-    std::memcpy(g_pending, path.c_str(), path.size() + 1);
-    g_pending_set.store(true);
+    if (path.size() >= sizeof g_pending[0]) return;  // too long to register: not removable early
+    for (int i = 0; i < kPendingSlots && slot_ < 0; ++i)
+      if (int none = kFree; g_pending_state[i].compare_exchange_strong(none, kFilling)) slot_ = i;
+    if (slot_ < 0) return;  // every slot taken: not removable early
+    std::memcpy(g_pending[slot_], path.c_str(), path.size() + 1);
+    g_pending_state[slot_].store(kSet);
   }
-  ~PendingGuard() { g_pending_set.store(false); }
+  ~PendingGuard() {
+    if (slot_ >= 0) g_pending_state[slot_].store(kFree);
+  }
   PendingGuard(const PendingGuard&) = delete;
   PendingGuard& operator=(const PendingGuard&) = delete;
+
+ private:
+  int slot_ = -1;
 };
 
 // Temporaries are ".nonplanar-PID-XXXXXX.tmp": short whatever the output's name (a 255-byte
@@ -72,7 +83,8 @@ Expected<void> write_in_place(const std::filesystem::path& file,
 }  // namespace
 
 void remove_pending_temporary_file() {
-  if (g_pending_set.load()) ::unlink(g_pending);
+  for (int i = 0; i < kPendingSlots; ++i)
+    if (g_pending_state[i].load() == kSet) ::unlink(g_pending[i]);
 }
 
 Expected<void> write_file_atomically(const std::filesystem::path& file_in,

@@ -16,8 +16,9 @@ namespace nonplanar {
 Expected<void> write_file_atomically(const std::filesystem::path& file,
                                      const std::function<bool(std::ostream&)>& write);
 
-/// Removes the temporary file a write_file_atomically call in progress is writing, if any.
-/// Async-signal-safe (one unlink): for a signal handler that is about to _exit.
+/// Removes the temporary files the write_file_atomically calls in progress are writing (up to
+/// 4 at once are known), if any. Async-signal-safe (unlink only): for a signal handler that is
+/// about to _exit.
 void remove_pending_temporary_file();
 
 }  // namespace nonplanar
