@@ -1,6 +1,8 @@
 // `slice --timings` (#20): the stages' wall times, read from their progress reports.
 #include <gtest/gtest.h>
 
+#include <cstdlib>
+#include <iterator>
 #include <regex>
 #include <string>
 
@@ -42,6 +44,26 @@ TEST(Timings, EveryStageOfACurvedSliceIsTimedAndTheSpansAddUp) {
   const auto q = test::run_cli("slice -q " + (dir / "roof.stl").string() + " -o " +
                                (dir / "roof.gcode").string());
   EXPECT_EQ(q.err.find("timings"), std::string::npos);
+}
+
+// Two reliefs through PrusaSlicer: no stack fits them, so a shell is tried, and refused (an
+// engine prints no shell beside material of the part's own height); the part is then sliced
+// planar by an attempt with the same patches, whose plan is not made a second time.
+TEST(Timings, ThePlanIsMadeOnceWhenTheShellIsRefused) {
+  if (std::system("prusa-slicer --help >/dev/null 2>&1") != 0)
+    GTEST_SKIP() << "prusa-slicer not installed";
+  const fs::path dir = test::temp_dir("timings_engine");
+  test::write_bytes(dir / "reliefs.stl", test::ascii_stl(test::two_reliefs(), "\n"));
+  const auto r =
+      test::run_cli("slice " + (dir / "reliefs.stl").string() + " -o " +
+                    (dir / "reliefs.gcode").string() + " --engine prusaslicer --timings");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("0 curved stacks"), std::string::npos) << r.err;
+  const std::regex layers_span(R"(\n  layers +[0-9]+\.[0-9]{3}\n)");
+  const auto n = std::distance(std::sregex_iterator(r.err.begin(), r.err.end(), layers_span),
+                               std::sregex_iterator());
+  EXPECT_EQ(n, 1) << r.err;
+  EXPECT_NE(r.err.find("\n  shell "), std::string::npos) << r.err;  // the shell was tried
 }
 
 }  // namespace
