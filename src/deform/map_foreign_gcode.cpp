@@ -17,6 +17,7 @@
 #include <cstdio>
 #include <optional>
 
+#include "deform/map_gcode_layer.hpp"
 #include "deform/map_segment.hpp"
 #include "nonplanar/deform.hpp"
 #include "program/gcode_text.hpp"
@@ -37,45 +38,6 @@ struct Writing {
   double pending = 0;    ///< filament owed from before the print, given back at the first E
   double retracted = 0;  ///< filament the print's own retractions leave pulled back
 };
-
-// Is m a move ForeignMapOptions::planar_lines keeps where the file has it?
-bool kept(const std::vector<char>& planar_lines, const GcodeMove& m) {
-  const auto k = static_cast<std::size_t>(m.line - 1);
-  return m.line > 0 && k < planar_lines.size() && planar_lines[k];
-}
-
-// Maps the layer's extrusions and wipes into work.mapped, and sets L's highest point and
-// steepest slope (which set how its travels clear it). Error once the file's points pass
-// params.most_points.
-std::optional<Error> map_layer(LayerWork& work, const LayerField& field,
-                               const MapBackParams& params, const std::vector<char>& planar_lines,
-                               LayerToolpaths& L, std::size_t& points) {
-  L.max_z = -1e300;
-  for (const GcodeLine& it : work.lines) {
-    if (it.kind != Kind::move) continue;
-    const GcodeMove& m = work.moves[static_cast<std::size_t>(it.move)];
-    if (!m.has_xy || !(m.extruding() || (m.wipe && m.de <= 0))) continue;
-    ExtrusionPath& p = work.mapped[static_cast<std::size_t>(it.move)];
-    if (kept(planar_lines, m)) {
-      p.points = {m.from, m.to};
-      p.height = {m.height, m.height};
-      add_to_reach(p, L);
-      continue;
-    }
-    const Mapped a = map_point(field, m.from, m.height), b = map_point(field, m.to, m.height);
-    p.points.push_back(a.p);
-    p.height.push_back(a.height);
-    map_segment(field, m.from, a, m.to, b, m.height, params.tolerance, 0, p);
-    points += p.points.size();
-    if (points > params.most_points)
-      return Error{Status::invalid_argument, "line " + std::to_string(m.line) + ": more than " +
-                                                 std::to_string(params.most_points) +
-                                                 " mapped points"};
-    add_to_reach(p, L);
-  }
-  if (L.max_z < -1e299) L.max_z = 0;
-  return std::nullopt;
-}
 
 // An extrusion or wipe (a travel step, retracting as it goes), one G1 per mapped piece; an
 // extrusion also goes into the gate's path (L.paths[*run], started when *run < 0). Adds the
@@ -194,7 +156,7 @@ void build_layer(const LayerWork& work, const LayerField& field, const MapBackPa
       continue;
     }
     run = -1;
-    add_travel(m, field, params, L, kept(planar_lines, m), s);
+    add_travel(m, field, params, L, kept_planar(planar_lines, m), s);
   }
   for (const std::size_t k : z_steps) s.layer.steps[k].value = L.max_z;
   for (const std::size_t k : h_steps)
@@ -202,6 +164,67 @@ void build_layer(const LayerWork& work, const LayerField& field, const MapBackPa
   L.z = L.max_z;
   L.height = planar_h;
   L.nonplanar = true;
+}
+
+// What the layers share while they are written in order.
+struct InOrder {
+  GcodeProgram& prog;
+  std::vector<ExtrusionPath>& mapped;
+  const LayerField& field;
+  const MapBackParams& params;
+  const ForeignMapOptions& options;
+  ForeignGcode& out;
+  Writing& s;
+  std::vector<char>& dropped;  ///< per layer: cut away whole
+  std::size_t clip_samples = 0, points = 0;
+};
+
+// One layer: cut back under the shell (options.clip), mapped (unless `premapped`, its point
+// count from map_gcode_layers, says it is), top skins ordered, built as steps and written.
+std::optional<Error> write_layer(InOrder& o, const GcodeLayerSpan& span,
+                                 std::optional<std::size_t> premapped) {
+  const std::vector<GcodeLine>& lines = o.prog.lines;
+  std::vector<GcodeLine> seq(lines.begin() + static_cast<long>(span.begin),
+                             lines.begin() + static_cast<long>(span.end));
+  LayerWork work{seq, o.prog.moves, o.mapped};
+  LayerToolpaths& L = o.out.layers[span.layer];
+  const double z = o.prog.layer_z[span.layer];
+  const auto cover = o.options.clip ? o.options.clip->cover(z) : LayerClip::Cover::all;
+  o.s.layer.clear();
+  if (cover == LayerClip::Cover::none) {
+    program::dropped_layer(seq, o.s.layer);
+    program::write_program_layer(o.s.w, o.s.layer);
+    o.dropped[span.layer] = 1;
+    return std::nullopt;
+  }
+  if (cover == LayerClip::Cover::some) {
+    auto margin = [&](double x, double y) { return o.options.clip->margin(x, y, z); };
+    auto bound = [&](const Vec2& lo, const Vec2& hi) {
+      return o.options.clip->slope_bound(lo, hi, z);
+    };
+    if (const int bad = program::clip_layer(work, margin, bound, o.prog.retraction, o.params.passes,
+                                            o.clip_samples))
+      return Error{Status::invalid_argument, "line " + std::to_string(bad) + ": more than " +
+                                                 std::to_string(o.params.passes.most_clip_samples) +
+                                                 " clip samples"};
+  }
+  if (premapped && *premapped != kFailed && o.points + *premapped <= o.params.most_points) {
+    o.points += *premapped;
+  } else {
+    // Here, in order: so a file past most_points is refused at the line where the count
+    // passes it, as when every layer is mapped in turn (what was mapped side by side goes).
+    if (premapped)
+      for (const GcodeLine& it : seq)
+        if (it.kind == Kind::move) o.mapped[static_cast<std::size_t>(it.move)] = {};
+    if (auto e = map_gcode_layer(seq, o.prog.moves, o.mapped, o.field, o.params,
+                                 o.options.planar_lines, L, o.points))
+      return e;
+  }
+  program::order_top_skins(work, o.params.passes);
+  build_layer(work, o.field, o.params, o.options.planar_lines, o.prog.layer_height[span.layer], L,
+              o.s);
+  program::write_program_layer(o.s.w, o.s.layer);
+  return std::nullopt;
 }
 
 }  // namespace
@@ -237,43 +260,22 @@ Expected<ForeignGcode> map_foreign_gcode(std::string_view text, const LayerField
   if (options.start) s.at = *options.start;
   s.pending = options.start_retracted;
   std::vector<char> dropped(prog.layer_height.size(), 0);
-  std::size_t clip_samples = 0, points = 0;
-  while (i < prog.print_end) {
-    std::size_t j = i + 1;
-    while (j < prog.print_end && lines[j].raw.rfind(";LAYER_CHANGE", 0) != 0) ++j;
-    const std::size_t lu = static_cast<std::size_t>(std::max(lines[i].layer, 0));
-    std::vector<GcodeLine> seq(lines.begin() + static_cast<long>(i),
-                               lines.begin() + static_cast<long>(j));
-    LayerWork work{seq, prog.moves, mapped};
-    const double z = prog.layer_z[lu];
-    const auto cover = options.clip ? options.clip->cover(z) : LayerClip::Cover::all;
-    i = j;
-    s.layer.clear();
-    if (cover == LayerClip::Cover::none) {
-      program::dropped_layer(seq, s.layer);
-      program::write_program_layer(s.w, s.layer);
-      dropped[lu] = 1;
-      continue;
-    }
-    if (cover == LayerClip::Cover::some) {
-      auto margin = [&](double x, double y) { return options.clip->margin(x, y, z); };
-      auto bound = [&](const Vec2& lo, const Vec2& hi) {
-        return options.clip->slope_bound(lo, hi, z);
-      };
-      if (const int bad = program::clip_layer(work, margin, bound, prog.retraction, params.passes,
-                                              clip_samples))
-        return Error{Status::invalid_argument, "line " + std::to_string(bad) + ": more than " +
-                                                   std::to_string(params.passes.most_clip_samples) +
-                                                   " clip samples"};
-    }
-    if (auto e = map_layer(work, field, params, options.planar_lines, out.layers[lu], points))
-      return *e;
-    program::order_top_skins(work, params.passes);
-    build_layer(work, field, params, options.planar_lines, prog.layer_height[lu], out.layers[lu],
-                s);
-    program::write_program_layer(s.w, s.layer);
+  const std::vector<GcodeLayerSpan> spans = gcode_layer_spans(prog);
+  // Nothing cut away: the layers are independent until their passes, and are mapped side by
+  // side first (the bunny from PrusaSlicer, 1000 layers: map back 2.02 s -> 1.54 s).
+  std::vector<std::size_t> premapped;
+  if (!options.clip)
+    premapped = map_gcode_layers(lines, spans, prog.moves, mapped, field, params,
+                                 options.planar_lines, out.layers, ctx);
+  InOrder o{prog, mapped, field, params, options, out, s, dropped};
+  for (std::size_t k = 0; k < spans.size(); ++k) {
     if (ctx.cancelled()) return Error{Status::cancelled, "cancelled"};
+    if (auto e = write_layer(o, spans[k],
+                             premapped.empty() ? std::nullopt : std::optional(premapped[k])))
+      return *e;
   }
+  if (ctx.cancelled()) return Error{Status::cancelled, "cancelled"};
+  i = prog.print_end;
   out.print = std::move(s.w.out);
   s.w.out.clear();
   out.end_at = s.at, out.retracted = s.retracted, out.relative_e_at_end = prog.at_end.relative_e;

@@ -21,29 +21,36 @@ CheckFigures figures(const std::string& gcode, const TriangleMesh& mesh) {
   return *f;
 }
 
-TEST(MapForeignGcode, PlanarFileOfTheNormalisedSaddlePrintsLikeTheBuiltInRoute) {
+// The saddle's plan, and a planar file of its normalised mesh from our own planar engine.
+struct NormalisedSaddle {
   PrintConfig c;
-  c.paths.fill_density = 1.0;
-  const TriangleMesh mesh = test::placed(test::saddle(), c);
-  const SliceJob job = make_job(c);
-  auto a = analyze(mesh, job.analysis, {});
-  ASSERT_TRUE(a);
-  std::vector<int> ids;
-  auto fits = fit_patches(mesh, *a, job.fit, {}, &ids, {});
-  ASSERT_TRUE(fits);
-  auto plan = plan_layers(mesh, *a, *fits, ids, job.layers, {});
-  ASSERT_TRUE(plan);
-  ASSERT_EQ(plan->stacks.size(), 1u);
-  auto n = normalize_mesh(mesh, *plan->field, {}, {});
-  ASSERT_TRUE(n);
-  auto sliced = slice_mesh(n->mesh, c.slice, {});
-  ASSERT_TRUE(sliced);
-  auto paths = make_toolpaths(*sliced, c.paths, {});
-  ASSERT_TRUE(paths);
-  auto planar = make_gcode(*paths, c, {}, {});
-  ASSERT_TRUE(planar);
+  TriangleMesh mesh;
+  SliceJob job;
+  LayerPlan plan;
+  std::string planar;
+  NormalisedSaddle() {
+    c.paths.fill_density = 1.0;
+    mesh = test::placed(test::saddle(), c);
+    job = make_job(c);
+    auto a = analyze(mesh, job.analysis, {});
+    std::vector<int> ids;
+    auto fits = fit_patches(mesh, *a, job.fit, {}, &ids, {});
+    plan = *plan_layers(mesh, *a, *fits, ids, job.layers, {});
+    auto n = normalize_mesh(mesh, *plan.field, {}, {});
+    auto paths = make_toolpaths(*slice_mesh(n->mesh, c.slice, {}), c.paths, {});
+    planar = *make_gcode(*paths, c, {}, {});
+  }
+};
 
-  auto mapped = map_foreign_gcode(*planar, *plan->field, {}, {});
+TEST(MapForeignGcode, PlanarFileOfTheNormalisedSaddlePrintsLikeTheBuiltInRoute) {
+  const NormalisedSaddle saddle;
+  const PrintConfig& c = saddle.c;
+  const TriangleMesh& mesh = saddle.mesh;
+  const SliceJob& job = saddle.job;
+  const LayerPlan* plan = &saddle.plan;
+  ASSERT_EQ(plan->stacks.size(), 1u);
+
+  auto mapped = map_foreign_gcode(saddle.planar, *plan->field, {}, {});
   ASSERT_TRUE(mapped) << mapped.error().message;
   const std::string mapped_text = mapped->text();  // the moves read below view it
   const CheckFigures f = figures(mapped_text, mesh);
@@ -103,6 +110,46 @@ TEST(MapForeignGcode, PlanarFileOfTheNormalisedSaddlePrintsLikeTheBuiltInRoute) 
   EXPECT_LE(hmax, job.layers.max_layer_height + 1e-3);
   EXPECT_LT(hmin, 0.19);  // some layers really are thinner than planar ...
   EXPECT_GT(hmax, 0.21);  // ... and some thicker
+}
+
+// Keeps every layer whole: a clip that changes nothing, which has the layers mapped one at a
+// time, in order.
+class KeepAll final : public LayerClip {
+ public:
+  Cover cover(double) const override { return Cover::all; }
+  double margin(double, double, double) const override { return 1; }
+};
+
+// With nothing clipped the layers are mapped side by side before they are written; the file,
+// the gate's paths and a refusal past most_points (its line) are what mapping them one at a
+// time gives.
+TEST(MapForeignGcode, LayersMappedSideBySideWriteWhatOneAtATimeDoes) {
+  const NormalisedSaddle saddle;
+  const KeepAll keep_all;
+  ForeignMapOptions in_order;
+  in_order.clip = &keep_all;
+  auto a = map_foreign_gcode(saddle.planar, *saddle.plan.field, {}, {});
+  auto b = map_foreign_gcode(saddle.planar, *saddle.plan.field, {}, {}, in_order);
+  ASSERT_TRUE(a && b);
+  EXPECT_TRUE(a->text() == b->text());  // (not EXPECT_EQ: the whole file)
+  ASSERT_EQ(a->layers.size(), b->layers.size());
+  std::size_t points = 0;
+  for (std::size_t i = 0; i < a->layers.size(); ++i) {
+    ASSERT_EQ(a->layers[i].paths.size(), b->layers[i].paths.size());
+    for (std::size_t k = 0; k < a->layers[i].paths.size(); ++k) {
+      EXPECT_EQ(a->layers[i].paths[k].points, b->layers[i].paths[k].points);
+      points += a->layers[i].paths[k].points.size();
+    }
+  }
+  ASSERT_GT(points, 4000u);
+  MapBackParams few;
+  few.most_points = points / 2;
+  auto c = map_foreign_gcode(saddle.planar, *saddle.plan.field, few, {});
+  auto d = map_foreign_gcode(saddle.planar, *saddle.plan.field, few, {}, in_order);
+  ASSERT_FALSE(c);
+  ASSERT_FALSE(d);
+  EXPECT_EQ(c.error().message, d.error().message);
+  EXPECT_NE(c.error().message.find("mapped points"), std::string::npos) << c.error().message;
 }
 
 TEST(MapForeignGcode, RefusesWhatItCannotMapNamingTheLine) {
