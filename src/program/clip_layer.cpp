@@ -88,8 +88,9 @@ int clip_layer(LayerWork& w, const std::function<double(double, double)>& margin
     const int n = std::max(1, static_cast<int>(std::ceil(len / params.clip_step)));
     samples += static_cast<std::size_t>(n) + 1;
     if (samples > params.most_clip_samples) return m.line;
-    // On the wing's core, 7 in 10 moves were then skipped whole, and the infill lines across
-    // the cut looked at in a few dozen places instead of 700: its clip took 0.61 s, now 0.1.
+    // On the wing's core 7 in 10 moves lie wholly on one side, clear of the cut, and a long
+    // infill line across it is looked at step by step only near it: the core's mapping took
+    // 0.61 s, now 0.10 s.
     const double slope = slope_bound ? slope_bound(m.from.head<2>().cwiseMin(m.to.head<2>()),
                                                    m.from.head<2>().cwiseMax(m.to.head<2>()))
                                      : std::numeric_limits<double>::infinity();
