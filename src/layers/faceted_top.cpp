@@ -129,21 +129,12 @@ FacetedTop faceted_top(const TriangleMesh& mesh, const Patch& patch, double cell
   std::vector<int> face(n, -1);  ///< the triangle that gave mz
   // The triangles' heights at the nodes inside them (the highest where two overlap in XY).
   for (int f : patch.faces) {
-    const Facet t3(mesh, f);
-    if (t3.d == 0) continue;
-    const Vec2 lo = (t3.xy_min() - t.origin) / t.cell, hi = (t3.xy_max() - t.origin) / t.cell;
-    const int i0 = std::max(0, static_cast<int>(std::ceil(lo.x())));
-    const int i1 = std::min(t.nx - 1, static_cast<int>(std::floor(hi.x())));
-    const int j0 = std::max(0, static_cast<int>(std::ceil(lo.y())));
-    const int j1 = std::min(t.ny - 1, static_cast<int>(std::floor(hi.y())));
-    for (int i = i0; i <= i1; ++i)
-      for (int j = j0; j <= j1; ++j) {
-        const double x = t.origin.x() + i * t.cell, y = t.origin.y() + j * t.cell;
-        if (!t3.covers(x, y)) continue;
-        const double z = t3.z(x, y);
-        const std::size_t q = static_cast<std::size_t>(i) * t.ny + j;
-        if (z > mz[q]) mz[q] = z, face[q] = f;
-      }
+    const auto& v = mesh.faces[f];
+    for_each_node_in(t, mesh.vertices[v[0]], mesh.vertices[v[1]], mesh.vertices[v[2]],
+                     [&](int i, int j, double z) {
+                       const std::size_t q = static_cast<std::size_t>(i) * t.ny + j;
+                       if (z > mz[q]) mz[q] = z, face[q] = f;
+                     });
   }
   // H: the triangles' heights (ring 0), then carried outward ring by ring.
   std::vector<int> ring(n, -1);

@@ -14,6 +14,8 @@
 // zone sees a tame top that no clamp has to bend.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <vector>
 
 #include "nonplanar/analysis.hpp"
@@ -32,6 +34,28 @@ struct FacetedTop {
   /// (∂H/∂x, ∂H/∂y) of the bilinear interpolant at (x, y).
   Vec2 gradient(double x, double y) const;
 };
+
+/// Calls f(i, j, z) for every node (i, j) of t's raster (at t.origin + (i, j)·t.cell) inside
+/// triangle abc seen from above, z its plane's height there; a vertical triangle covers none.
+template <class F>
+void for_each_node_in(const FacetedTop& t, const Vec3& a, const Vec3& b, const Vec3& c, F&& f) {
+  const double d = (b.x() - a.x()) * (c.y() - a.y()) - (c.x() - a.x()) * (b.y() - a.y());
+  if (d == 0) return;
+  const Vec2 lo = (a.head<2>().cwiseMin(b.head<2>()).cwiseMin(c.head<2>()) - t.origin) / t.cell;
+  const Vec2 hi = (a.head<2>().cwiseMax(b.head<2>()).cwiseMax(c.head<2>()) - t.origin) / t.cell;
+  const int i0 = std::max(0, static_cast<int>(std::ceil(lo.x())));
+  const int i1 = std::min(t.nx - 1, static_cast<int>(std::floor(hi.x())));
+  const int j0 = std::max(0, static_cast<int>(std::ceil(lo.y())));
+  const int j1 = std::min(t.ny - 1, static_cast<int>(std::floor(hi.y())));
+  for (int i = i0; i <= i1; ++i)
+    for (int j = j0; j <= j1; ++j) {
+      const Vec2 q = t.origin + Vec2(i, j) * t.cell;
+      const double u = ((q.x() - a.x()) * (c.y() - a.y()) - (c.x() - a.x()) * (q.y() - a.y())) / d;
+      const double v = ((b.x() - a.x()) * (q.y() - a.y()) - (q.x() - a.x()) * (b.y() - a.y())) / d;
+      if (u < -1e-9 || v < -1e-9 || u + v > 1 + 1e-9) continue;
+      f(i, j, a.z() + u * (b.z() - a.z()) + v * (c.z() - a.z()));
+    }
+}
 
 /// A bound on H's slope over boxes, for a caller that can skip the points where it cannot
 /// change sign. Within a cell the bilinear interpolant's ∂H/∂x is a mix of the cell's two

@@ -31,28 +31,10 @@ struct Raster {
         std::clamp(static_cast<int>(std::lround((y - t.origin.y()) / t.cell)), 0, t.ny - 1);
     return index(i, j);
   }
-  /// Calls f(i, j, z) for every node inside triangle abc seen from above, z its plane's height
-  /// there (vertical triangles cover no node).
+  /// for_each_node_in (faceted_top.hpp) on this raster.
   template <class F>
   void covered(const Vec3& a, const Vec3& b, const Vec3& c, F&& f) const {
-    const double d = (b.x() - a.x()) * (c.y() - a.y()) - (c.x() - a.x()) * (b.y() - a.y());
-    if (d == 0) return;
-    const Vec2 lo = (a.head<2>().cwiseMin(b.head<2>()).cwiseMin(c.head<2>()) - t.origin) / t.cell;
-    const Vec2 hi = (a.head<2>().cwiseMax(b.head<2>()).cwiseMax(c.head<2>()) - t.origin) / t.cell;
-    const int i0 = std::max(0, static_cast<int>(std::ceil(lo.x())));
-    const int i1 = std::min(t.nx - 1, static_cast<int>(std::floor(hi.x())));
-    const int j0 = std::max(0, static_cast<int>(std::ceil(lo.y())));
-    const int j1 = std::min(t.ny - 1, static_cast<int>(std::floor(hi.y())));
-    for (int i = i0; i <= i1; ++i)
-      for (int j = j0; j <= j1; ++j) {
-        const Vec2 q = node(i, j);
-        const double u =
-            ((q.x() - a.x()) * (c.y() - a.y()) - (c.x() - a.x()) * (q.y() - a.y())) / d;
-        const double v =
-            ((b.x() - a.x()) * (q.y() - a.y()) - (q.x() - a.x()) * (b.y() - a.y())) / d;
-        if (u < -1e-9 || v < -1e-9 || u + v > 1 + 1e-9) continue;
-        f(i, j, a.z() + u * (b.z() - a.z()) + v * (c.z() - a.z()));
-      }
+    for_each_node_in(t, a, b, c, std::forward<F>(f));
   }
 };
 
