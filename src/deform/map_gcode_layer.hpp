@@ -37,11 +37,13 @@ struct GcodeLayerSpan {
 /// next.
 std::vector<GcodeLayerSpan> gcode_layer_spans(const GcodeProgram& prog);
 
+/// map_gcode_layers' count for a layer it did not finish.
+inline constexpr std::size_t kFailed = static_cast<std::size_t>(-1);
+
 /// Each layer mapped by map_gcode_layer, side by side, each counting its own points from 0
 /// (into layers[span.layer]). Output: each span's point count, or kFailed where it passed
 /// most_points alone or the run was cancelled (the caller maps that layer again in order, to
 /// report the error at the line the whole file's count passes it).
-inline constexpr std::size_t kFailed = static_cast<std::size_t>(-1);
 std::vector<std::size_t> map_gcode_layers(std::span<const GcodeLine> lines,
                                           const std::vector<GcodeLayerSpan>& spans,
                                           const std::vector<GcodeMove>& moves,
