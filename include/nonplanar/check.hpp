@@ -2,7 +2,9 @@
 // PrusaSlicer's / OrcaSlicer's) into moves and recomputes every quality figure from them.
 #pragma once
 
+#include <deque>
 #include <functional>
+#include <memory>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -31,9 +33,9 @@ struct CheckParams {
   double within_tolerance = 0.03;
 };
 
-/// The figures of DESIGN.md §4. Deviation is vertical, mm; thickness is the height of each
-/// extrusion above the previous layer's extrusions there (least-squares plane within
-/// 0.6 mm); angles in degrees.
+/// The figures of DESIGN.md §4. Deviation is vertical, mm; thickness is LayerGaps': the
+/// height of one layer's extrusions over the previous layer's where they cross; angles in
+/// degrees.
 struct CheckFigures {
   std::size_t surface_samples = 0, covered_samples = 0;
   /// Samples covered and at most within_tolerance off, over all samples (an uncovered sample
@@ -42,7 +44,7 @@ struct CheckFigures {
   double within_share = 0;
   double deviation_mean = 0, deviation_p95 = 0, deviation_max = 0;
   double thickness_min = 0, thickness_max = 0;
-  Vec3 thickness_min_at{0, 0, 0}, thickness_max_at{0, 0, 0};  ///< the extrusion samples
+  Vec3 thickness_min_at{0, 0, 0}, thickness_max_at{0, 0, 0};  ///< the crossings
   double steepest_deg = 0;
   std::size_t collisions = 0;
   Vec3 first_collision{0, 0, 0};
@@ -52,6 +54,10 @@ struct CheckFigures {
   double outside_fraction = 0;         ///< extrusion points outside the mesh (skirt excluded)
   std::size_t extrusions = 0;
 };
+
+/// The extrusions the figures count: inside the print (after the first layer change), not the
+/// skirt.
+bool counted(const PrintMove& m);
 
 /// The check's settings for a print made with `print` (layer height, filament, toolhead) and
 /// facets up to `max_angle_deg` printable: the gate and `check` build them alike.
@@ -83,6 +89,58 @@ using MoveReplay = std::function<void(const std::function<void(const PrintMove&)
 Expected<CollisionFigures> find_collisions(const MoveReplay& moves, const CheckParams& params,
                                            const std::function<bool(const Vec3&)>& looked_at,
                                            const Context& ctx);
+
+/// One place where layer thickness was measured: where, seen from above, an extrusion crosses
+/// an earlier one that is the top of the material under it there, the height of the upper
+/// centre line over the lower one. at: the crossing, on the upper line. curved: searched
+/// (a flat layer over flat ones counts once, at its height over the highest, unsearched).
+/// spans: the two may be more than a layer apart, so it counts for the thinnest only: either
+/// line is laid across gaps by design (sparse infill over its lattice, a bridge, support), or
+/// the lower one was not printed in the layer just before (a shell's piece over a core).
+struct CrossingGap {
+  double gap = 0;
+  Vec3 at{0, 0, 0};
+  bool curved = false;
+  bool spans = false;
+};
+
+/// Layer thickness as the file's own lines give it (DESIGN.md §3), for check and the safety
+/// gate alike: wherever a layer's extrusion crosses, seen from above, an earlier layer's
+/// (any of the last 24, so a shell's pieces printed between a core's layers find theirs) with
+/// no other layer's line between the two within 0.15 mm, up to 1 mm under it (deeper is a
+/// bridge). The first layer, over the bed, and the skirt do not count. Exact on the chords
+/// written: a curved layer's chord that strays from its surface shows here, where a thickness
+/// taken at the points would not. Moves go in file order; `visit` (may be null) sees each gap
+/// and stops the measuring by returning false.
+class LayerGaps {
+ public:
+  explicit LayerGaps(std::function<bool(const CrossingGap&)> visit = nullptr);
+  ~LayerGaps();
+  LayerGaps(const LayerGaps&) = delete;
+  LayerGaps& operator=(const LayerGaps&) = delete;
+  /// The file's next move (any kind: only the extrusions counted are kept).
+  void add(const PrintMove& m);
+  /// Measures the last pair of layers; then the figures are final.
+  void finish();
+  bool stopped() const { return stopped_; }
+  double min = 0, max = 0;  ///< mm; 0 without any crossing
+  Vec3 min_at{0, 0, 0}, max_at{0, 0, 0};
+  std::size_t crossings = 0;
+
+ private:
+  struct Layer;
+  class LineGrid;
+  void close_layer();
+  void measure_crossings(const Layer& up, const std::vector<Layer*>& under);
+  bool cross(const Layer& up, std::size_t i, const Layer& dn, const LineGrid& g,
+             const std::vector<Layer*>& under, bool first);
+  static bool on_top(const Layer& dn, const std::vector<Layer*>& under, const Vec3& x, double z_dn);
+  void record(const CrossingGap& g);
+  std::function<bool(const CrossingGap&)> visit_;
+  std::deque<std::unique_ptr<Layer>> window_;  ///< earlier layers, oldest first
+  std::unique_ptr<Layer> current_;
+  bool stopped_ = false;
+};
 
 /// Computes the figures; `mesh` (placed like the G-code) may be null, then deviation,
 /// volume ratio and outside fraction are left at 0. Errors: cancelled.

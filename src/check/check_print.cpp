@@ -33,16 +33,12 @@ struct Pt {
   bool sparse = false;  ///< sparse infill (";TYPE:Internal infill")
 };
 
-bool counts(const PrintMove& m) {
-  return m.extruding && m.layer >= 0 && m.type != "Skirt/Brim";
-}
-
 // Calls f on every extrusion point: every 0.2 mm along each counted move (the coverage test
 // allows half of that beyond half a line width), in print order.
 template <class F>
 void for_each_sample(const std::vector<PrintMove>& moves, F&& f) {
   for (const PrintMove& m : moves) {
-    if (!counts(m)) continue;
+    if (!counted(m)) continue;
     const int n = std::max(1, static_cast<int>(std::ceil((m.to - m.from).norm() / 0.2)));
     const bool sparse = m.type == "Internal infill";
     for (int k = 1; k <= n; ++k)
@@ -342,7 +338,7 @@ Expected<Samples> sample_extrusions(const MoveReplay& moves) {
     if (error || !m.extruding || m.layer < 0) return;
     s.z_lo = std::min({s.z_lo, m.from.z(), m.to.z()});
     s.z_hi = std::max({s.z_hi, m.from.z(), m.to.z()});
-    if (!counts(m)) return;
+    if (!counted(m)) return;
     s.filament += m.filament;
     const double len = (m.to - m.from).norm();
     const int n = std::max(1, static_cast<int>(std::ceil(len / 0.2)));
@@ -367,58 +363,6 @@ Expected<Samples> sample_extrusions(const MoveReplay& moves) {
   });
   if (error) return *error;
   return s;
-}
-
-// The thickness at sample q: its height above the previous layer's extrusions there; false
-// where there is nothing to measure against (the first layer, a bridge, sparse infill far
-// below).
-bool thickness_at(const PointGrid& grid, const Pt& q, double* t) {
-  double below = 0;
-  *t = q.p.z();
-  Vec3 r(1e300, 0, 0);
-  const bool fits = q.layer > 0 && plane_z(grid, q.layer - 1, q.p.x(), q.p.y(), &below, &r, true);
-  // Nothing under it within 0.2 mm (a bridge, or a solid layer over sparse infill): a
-  // plane through lines farther away would be an extrapolation, not a thickness.
-  if (fits && (r.head<2>() - q.p.head<2>()).squaredNorm() > 0.2 * 0.2) return false;
-  if (fits) {
-    // This layer's height from the same kind of plane: where a curved stack bends (the
-    // rim of a patch) a plane through lines 0.45 mm apart misreads a layer's height by a
-    // few hundredths of a mm, and consecutive layers bend alike, so the two misreadings
-    // cancel in the difference. A single line here: its own height.
-    double here = q.p.z();
-    Vec3 line;
-    if (!plane_z(grid, q.layer, q.p.x(), q.p.y(), &here, &line, true)) here = q.p.z();
-    *t = here - below;
-    return true;
-  }
-  if (q.layer <= 0) return true;  // the first layer: its height above the bed
-  // The layer below is a single line here (the edge of a region, sparse infill): on a
-  // slope its nearest point's height is off by the slope times the distance, so
-  // measure at that point instead, carrying this sample's height there along this
-  // layer's slope (consecutive layers are nearly parallel). The slope, not the plane's
-  // height: at the edge of a region the plane is extrapolated past its last line and
-  // bends with the layer (0.06 mm high on the bunny). No point within 0.2 mm: a bridge,
-  // not a thickness.
-  double here = 0;
-  Vec3 unused;
-  Vec2 slope;
-  if (r.x() > 1e299 || (r.head<2>() - q.p.head<2>()).squaredNorm() > 0.2 * 0.2 ||
-      !plane_z(grid, q.layer, q.p.x(), q.p.y(), &here, &unused, true, &slope))
-    return false;
-  *t = q.p.z() + slope.dot(r.head<2>() - q.p.head<2>()) - r.z();
-  return true;
-}
-
-void measure_thickness(const PointGrid& grid, CheckFigures& f) {
-  f.thickness_min = 1e300, f.thickness_max = 0;
-  const std::vector<Pt>& all = grid.points();
-  for (std::size_t k = 0; k < all.size(); k += 3) {
-    double t = 0;
-    if (!thickness_at(grid, all[k], &t)) continue;
-    if (t < f.thickness_min) f.thickness_min = t, f.thickness_min_at = all[k].p;
-    if (t > f.thickness_max) f.thickness_max = t, f.thickness_max_at = all[k].p;
-  }
-  if (f.thickness_min > f.thickness_max) f.thickness_min = f.thickness_max = 0;
 }
 
 // Collisions, in print order, among the points `looked_at` accepts (null: all).
@@ -525,6 +469,10 @@ void measure_deviation(const PointGrid& grid, const ColumnCaster& cols, const Tr
 
 }  // namespace
 
+bool counted(const PrintMove& m) {
+  return m.extruding && m.layer >= 0 && m.type != "Skirt/Brim";
+}
+
 CheckParams check_params(const PrintConfig& print, double max_angle_deg) {
   CheckParams cp;
   cp.max_angle_deg = max_angle_deg;
@@ -560,8 +508,12 @@ Expected<CheckFigures> check_print(const std::vector<PrintMove>& moves, const Tr
   f.extrusions = s->extrusions, f.steepest_deg = s->steepest_deg;
   if (f.extrusions == 0) return f;
   if (ctx.cancelled()) return Error{Status::cancelled, "cancelled"};
+  LayerGaps gaps;
+  for (const PrintMove& m : moves) gaps.add(m);
+  gaps.finish();
+  f.thickness_min = gaps.min, f.thickness_max = gaps.max;
+  f.thickness_min_at = gaps.min_at, f.thickness_max_at = gaps.max_at;
   const PointGrid grid(moves, s->lo, s->hi);
-  measure_thickness(grid, f);
   if (ctx.cancelled()) return Error{Status::cancelled, "cancelled"};
   ctx.progress("check", 0.3);
   auto c = search_collisions(replay(moves), *s, cp, nullptr, ctx);

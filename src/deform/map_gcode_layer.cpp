@@ -34,7 +34,7 @@ std::optional<Error> map_gcode_layer(std::span<const GcodeLine> lines,
     const Mapped a = map_point(field, m.from, m.height), b = map_point(field, m.to, m.height);
     p.points.push_back(a.p);
     p.height.push_back(a.height);
-    map_segment(field, m.from, a, m.to, b, m.height, params.tolerance, 0, p);
+    map_segment(field, m.from, a, m.to, b, m.height, params, 0, p);
     points += p.points.size();
     if (points > params.most_points)
       return Error{Status::invalid_argument, "line " + std::to_string(m.line) + ": more than " +

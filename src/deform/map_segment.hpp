@@ -5,6 +5,7 @@
 // z = z(x, y, t) and the layer under it spans t − Δt … t with Δt = t(ζ) − t(ζ − h).
 #pragma once
 
+#include "nonplanar/deform.hpp"
 #include "nonplanar/layers.hpp"
 #include "nonplanar/toolpaths.hpp"
 
@@ -20,10 +21,13 @@ struct Mapped {
 Mapped map_point(const LayerField& f, const Vec3& q, double h_planar);
 
 /// Appends the mapped segment a → b to out (points and heights; a's image is already there),
-/// split at midpoints while a mapped midpoint strays more than tol from its chord, and cut to
-/// at most 1 mm wherever the segment meets a curved band. depth: recursion depth (start at 0).
+/// cut to at most 1 mm wherever the segment meets a curved band, then split while a mapped
+/// point (the midpoint, then probes params.probe_spacing apart) strays farther from its chord
+/// than params.tolerance, or than half the layer's margin over params.min_layer_height.
+/// depth: recursion depth (start at 0).
 void map_segment(const LayerField& f, const Vec3& a, const Mapped& ma, const Vec3& b,
-                 const Mapped& mb, double h, double tol, int depth, ExtrusionPath& out);
+                 const Mapped& mb, double h, const MapBackParams& params, int depth,
+                 ExtrusionPath& out);
 
 /// Widens L's highest point (max_z) and steepest slope (max_slope, |dz| / dxy over pieces
 /// longer than 1 µm in XY) by the mapped path p, which set how travels clear the layer;

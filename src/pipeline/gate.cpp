@@ -2,10 +2,12 @@
 #include "pipeline/gate.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdio>
 
 #include "core/parallel.hpp"
+#include "nonplanar/check.hpp"
 #include "nonplanar/gcode.hpp"
 #include "nonplanar/program.hpp"
 #include "nonplanar/toolpaths.hpp"
@@ -45,25 +47,19 @@ Expected<void> write_program(SliceResult& r, const SliceJob& job, const Context&
 
 namespace {
 
-// Thickness within [h_min, h_max] on the paths, with g's slack (the file holds no per-point
-// thickness; the paths' heights are the ones the extrusion was computed from); fills r's
-// thickness figures.
-bool thickness(SliceResult& r, const LayerParams& L, const GateParams& g,
-               const Violation& violation) {
-  r.thickness_min = 1e300, r.thickness_max = 0;
+// Thickness within [h_min, h_max] on the paths' heights, with g's slack: the ones each
+// point's extrusion was computed from (the file holds none).
+bool heights(const SliceResult& r, const LayerParams& L, const GateParams& g,
+             const Violation& violation) {
   for (std::size_t li = 1; li < r.layers.size(); ++li)
     for (const ExtrusionPath& p : r.layers[li].paths) {
       if (p.role == ExtrusionRole::skirt) continue;
-      for (std::size_t k = 0; k < p.points.size(); ++k) {
-        r.thickness_min = std::min(r.thickness_min, p.height[k]);
-        r.thickness_max = std::max(r.thickness_max, p.height[k]);
+      for (std::size_t k = 0; k < p.points.size(); ++k)
         if ((p.height[k] < L.min_layer_height - g.thickness_slack ||
              p.height[k] > L.max_layer_height + g.thickness_slack) &&
             !violation(p.points[k], "a layer leaves the thickness limits"))
           return false;
-      }
     }
-  if (r.thickness_min > r.thickness_max) r.thickness_min = r.thickness_max = 0;
   return true;
 }
 
@@ -89,34 +85,78 @@ bool slopes(SliceResult& r, const LayerParams& L, const GateParams& g, const Vio
   return go_on;
 }
 
+// Thickness where a layer's lines cross the ones under them in r.gcode (LayerGaps, as check
+// measures it), among the moves `keep` accepts (null: all): where a layer is curved, the
+// crossings thinner than h_min less g's slack go to `thin`, in file order (flat layers are
+// the planar engine's; too thick is the paths' heights' to judge: a line over a gap by design,
+// sparse infill or a bridge, crosses lines more than a layer down). Gives up when `abandon`
+// turns true. Fills r's thickness figures (check's, to the digit).
+void crossings(SliceResult& r, const LayerParams& L, const GateParams& g,
+               const std::function<bool(const GcodeMove&)>& keep, const std::atomic<bool>& abandon,
+               std::vector<Vec3>& thin) {
+  LayerGaps gaps([&](const CrossingGap& c) {
+    if (c.curved && c.gap < L.min_layer_height - g.thickness_slack) thin.push_back(c.at);
+    return !abandon.load(std::memory_order_relaxed);
+  });
+  for_each_print_move(r.gcode, keep, [&](const PrintMove& m) {
+    if (!abandon.load(std::memory_order_relaxed)) gaps.add(m);
+  });
+  gaps.finish();
+  r.thickness_min = gaps.min, r.thickness_max = gaps.max;
+}
+
 }  // namespace
 
 Expected<bool> gate(SliceResult& r, const SliceJob& job, const layers::BandedField* banded,
                     const Violation& violation, const Context& ctx) {
   ctx.progress("gate", 0);
-  if (!thickness(r, job.layers, job.gate, violation)) return false;
+  if (!heights(r, job.layers, job.gate, violation)) return false;
   if (auto w = write_program(r, job, ctx); !w) return w.error();
   ctx.progress("gate", 0);
-  if (!slopes(r, job.layers, job.gate, violation)) return false;
-  if (!r.nonplanar) return true;  // planar layers cannot dig into earlier ones
-  // Collisions: in the program about to be written, read back as `check` reads the file, so
-  // the two agree to the last digit. They are looked for even when bands already broke a
-  // limit, so one retry drops every offender (each retry replans, reslices and rechecks).
-  // The file's time and filament (with_print_stats' reading), measured on the other core
-  // while this one searches: on the bunny each took about 0.9 s. Kept when this program is
-  // the one written (r.stats_in_gcode).
-  PrintStatsStamp stamp;
-  core::Background beside;
-  beside.run([&] { stamp = measure_print_stats(r.gcode, job.print); });
-  ctx.progress("collisions", 0);
-  // Only where a curved layer is within the head's reach (gate_zones.hpp): on the bunny that
-  // skipped most of 24 million extrusion samples. Without bands, only at the heights printed
-  // out of order (1 mm of slack for the file's rounding) and up to the last layer that has
-  // such a point: the bunny's shell, 4 layers over 112-128 mm of a 200 mm part, took 1.1 s
-  // searched everywhere. (Layer i of the file is r.layers[i], as for the bands.)
+  // Collisions and crossings only where a curved layer is within the head's reach
+  // (gate_zones.hpp): on the bunny that skipped most of 24 million extrusion samples. Without
+  // bands, only at the heights printed out of order (1 mm of slack for the file's rounding)
+  // and up to the last layer that has such a point: the bunny's shell, 4 layers over
+  // 112-128 mm of a 200 mm part, took 1.1 s searched everywhere. (Layer i of the file is
+  // r.layers[i], as for the bands.) Planar layers elsewhere neither dig into earlier ones nor
+  // cross them closer than their heights.
   GateZones zones = banded ? gate_zones(*banded, job.check.toolhead.reach()) : GateZones{};
   zones.find_last_layers(r.layers);
   const OutOfOrder late = banded ? OutOfOrder{} : out_of_order(r.layers);
+  std::function<bool(const GcodeMove&)> keep;
+  if (r.nonplanar)
+    keep = [&](const GcodeMove& m) {
+      return banded ? zones.may_matter(m, m.layer)
+                    : late.may_matter(std::max(m.from.z(), m.to.z()), m.layer);
+    };
+  // The crossings on the other core while this one reads the slopes and searches for
+  // collisions (on the bunny they took 0.7 s); then the file's time and filament
+  // (with_print_stats' reading: 0.9 s on the bunny), kept when this program is the one
+  // written (r.stats_in_gcode).
+  std::atomic<bool> abandon{false};
+  std::vector<Vec3> thin;
+  PrintStatsStamp stamp;
+  core::Background beside;
+  beside.run([&] { crossings(r, job.layers, job.gate, keep, abandon, thin); });
+  if (r.nonplanar) beside.run([&] { stamp = measure_print_stats(r.gcode, job.print); });
+  if (!slopes(r, job.layers, job.gate, violation)) {
+    abandon = true;
+    beside.wait();
+    return false;
+  }
+  auto thin_ones = [&] {
+    for (const Vec3& p : thin)
+      if (!violation(p, "a layer crosses the one under it thinner than h_min")) return false;
+    return true;
+  };
+  if (!r.nonplanar) {  // planar layers cannot dig into earlier ones
+    beside.wait();
+    return thin_ones();
+  }
+  // Collisions: in the program about to be written, read back as `check` reads the file, so
+  // the two agree to the last digit. They are looked for even when bands already broke a
+  // limit, so one retry drops every offender (each retry replans, reslices and rechecks).
+  ctx.progress("collisions", 0);
   std::function<bool(const Vec3&)> looked_at;
   if (!zones.query.empty())
     looked_at = [&](const Vec3& p) {
@@ -124,10 +164,6 @@ Expected<bool> gate(SliceResult& r, const SliceJob& job, const layers::BandedFie
                          [&](const BoundingBox& b) { return b.contains(p); });
     };
   if (!banded) looked_at = [&](const Vec3& p) { return late.looked_at(p); };
-  auto keep = [&](const GcodeMove& m) {
-    return banded ? zones.may_matter(m, m.layer)
-                  : late.may_matter(std::max(m.from.z(), m.to.z()), m.layer);
-  };
   // Read from the text twice (the extrusions' box, then the search) rather than held: on the
   // bunny the moves were 110 MB at the slice's peak; its slice took no longer so.
   const MoveReplay moves = [&](const std::function<void(const PrintMove&)>& f) {
@@ -136,6 +172,7 @@ Expected<bool> gate(SliceResult& r, const SliceJob& job, const layers::BandedFie
   auto figures = find_collisions(moves, job.check, looked_at, ctx);
   beside.wait();
   if (!figures) return figures.error();
+  if (!thin_ones()) return false;
   // In place, once the search no longer reads the text (and its grids are gone): a copy of
   // the bunny's 37 MB program was alive beside them.
   stamp_print_stats(r.gcode, stamp);

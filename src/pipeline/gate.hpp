@@ -16,8 +16,9 @@ using Violation = std::function<bool(const Vec3&, const char*)>;
 /// field's bands when the part has curved stacks (collisions are then looked for only near
 /// them: gate_zones.hpp; null: everywhere). Checks thickness within [h_min, h_max] on the
 /// paths' heights, then, in the program about to be written (r.gcode, made here by
-/// write_program when empty) read back by the one reader: slope within max_angle (both with
-/// job.gate's slack), and, when something is curved, collisions with earlier layers, searched
+/// write_program when empty) read back by the one reader: slope within max_angle, thickness
+/// where consecutive layers' lines cross (check's LayerGaps; within the limits where a layer
+/// is curved), both with job.gate's slack, and, when something is curved, collisions with earlier layers, searched
 /// by check's own collision search. Every breach goes to `violation`. Output: false when
 /// `violation` said stop; fills r's figures. Errors: those of write_program, cancelled.
 Expected<bool> gate(SliceResult& r, const SliceJob& job, const layers::BandedField* banded,

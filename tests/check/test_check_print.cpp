@@ -32,12 +32,15 @@ TEST(CheckPrint, StackedLayersHaveTheirThicknessAndNoCollision) {
   EXPECT_NEAR(f->steepest_deg, 0, 1e-9);
 }
 
-TEST(CheckPrint, ThicknessOverTheEdgeOfASlopedLayerBelow) {
-  // Layer 0 is one line along x at y = 0, z = 0.2; layer 1 is a raster sloped in y,
-  // z = 0.4 + 0.5 y: 0.2 mm above layer 0 where it lies. (Measured from the line's nearest
-  // point, a line of layer 1 at y = 0.15 was 0.275 mm thick.)
+TEST(CheckPrint, ThicknessOfASlopedLayerOverALineAcrossIt) {
+  // Layer 0 is one line along y at x = 5, z = 0.2 + 0.5 y; layer 1 is a raster along x sloped
+  // the same way, z = 0.4 + 0.5 y: 0.2 mm above layer 0 wherever they cross. (A plane fit
+  // through lines 0.15 mm apart read the edge of such a layer 0.275 mm thick.)
   std::vector<PrintMove> moves;
-  raster(moves, 0, 10, 0, 0.2);
+  PrintMove line;
+  line.from = {5, -0.4, 0.0}, line.to = {5, 0.4, 0.4};
+  line.filament = 0.03, line.extruding = true, line.layer = 0, line.type = "Solid infill";
+  moves.push_back(line);
   for (double y = -0.3; y <= 0.3 + 1e-9; y += 0.15) {
     PrintMove m;
     m.from = {0, y, 0.4 + 0.5 * y}, m.to = {10, y, 0.4 + 0.5 * y};
@@ -46,8 +49,9 @@ TEST(CheckPrint, ThicknessOverTheEdgeOfASlopedLayerBelow) {
   }
   auto f = check_print(moves, nullptr, {}, {});
   ASSERT_TRUE(f);
-  EXPECT_NEAR(f->thickness_min, 0.2, 1e-6);
-  EXPECT_NEAR(f->thickness_max, 0.2, 1e-6);
+  EXPECT_NEAR(f->thickness_min, 0.2, 1e-9);
+  EXPECT_NEAR(f->thickness_max, 0.2, 1e-9);
+  EXPECT_NEAR(f->thickness_min_at.x(), 5, 1e-9);
 }
 
 TEST(CheckPrint, NozzleBelowEarlierMaterialCollides) {

@@ -5,6 +5,7 @@
 #include <map>
 
 #include "layers/shell_plan.hpp"
+#include "nonplanar/check.hpp"
 #include "nonplanar/gcode.hpp"
 #include "nonplanar/io.hpp"
 #include "nonplanar/pipeline.hpp"
@@ -124,6 +125,50 @@ TEST(NonplanarPrint, DomeCutByABox) {
 // A shared curved model whose fit swings off the patch (before the top was tamed there, the
 // blend made a 0.024 mm layer and the patch fell back to planar). PrusaSlicer's planar
 // p95 on it is 0.085 mm.
+// The held-out dome at max_angle 20 (issue #21, item 7): its faceted top has a dip 0.25 mm
+// wide and 0.015 mm deep beside the box's wall, off the middle of a chord over it. Layers
+// crossed there 0.094 mm apart against h_min 0.1, while the gate read 0.106 at the points and
+// check 0.078 from its plane fits. Counted here by brute force, wherever a layer's line
+// crosses one of the layer before, they are at least h_min apart less the gate's slack; and
+// slice's figures are check's to the digit.
+TEST(NonplanarPrint, HeldOutDomeAt20DegreesCrossesNoCloserThanHMin) {
+  const PrintConfig c;
+  const TriangleMesh mesh = test::placed(test::dome_cut_by_box(), c);
+  const SliceJob job = make_job(c, 20);
+  auto r = slice_model(mesh, job, {});
+  ASSERT_TRUE(r) << r.error().message;
+  ASSERT_EQ(r->plan.stacks.size(), 1u);
+  auto moves = read_gcode_moves(r->gcode);
+  ASSERT_TRUE(moves);
+  auto f = check_print(*moves, nullptr, job.check, {});
+  ASSERT_TRUE(f);
+  EXPECT_EQ(f->thickness_min, r->thickness_min);
+  EXPECT_EQ(f->thickness_max, r->thickness_max);
+  std::map<int, std::vector<const PrintMove*>> by_layer;
+  for (const PrintMove& m : *moves)
+    if (counted(m)) by_layer[m.layer].push_back(&m);
+  double least = 1e300;
+  std::size_t crossings = 0;
+  for (auto up = std::next(by_layer.begin()); up != by_layer.end(); ++up)
+    for (const PrintMove* s : up->second)
+      for (const PrintMove* t : std::prev(up)->second) {
+        const Vec2 d1 = (s->to - s->from).head<2>(), d2 = (t->to - t->from).head<2>();
+        const Vec2 w = (t->from - s->from).head<2>();
+        const double den = d1.x() * d2.y() - d1.y() * d2.x();
+        if (std::abs(den) < 1e-12) continue;
+        const double u = (w.x() * d2.y() - w.y() * d2.x()) / den;
+        const double v = (w.x() * d1.y() - w.y() * d1.x()) / den;
+        if (u < 0 || u > 1 || v < 0 || v > 1) continue;
+        const double gap = s->from.z() + u * (s->to.z() - s->from.z()) - t->from.z() -
+                           v * (t->to.z() - t->from.z());
+        ++crossings;
+        least = std::min(least, gap);
+      }
+  EXPECT_GT(crossings, 10000u);
+  EXPECT_GE(least, job.layers.min_layer_height - job.gate.thickness_slack);
+  EXPECT_GE(r->thickness_min, job.layers.min_layer_height - job.gate.thickness_slack);
+}
+
 TEST(NonplanarPrint, SharedFoilCutter) {
   const auto dir = test::shared_models();
   if (dir.empty()) GTEST_SKIP() << "../shared/models not present";

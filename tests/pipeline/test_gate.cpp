@@ -3,8 +3,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <string>
 
+#include "nonplanar/check.hpp"
 #include "pipeline/gate.hpp"
 #include "pipeline/gate_zones.hpp"
 
@@ -142,6 +144,47 @@ TEST(Gate, JudgesSlopesOnTheProgramWritten) {
   SliceResult steep;
   EXPECT_FALSE(run(1.5, &where, &steep));
   EXPECT_NEAR((where - Vec3(41.5, 10, 2.2)).norm(), 0, 1e-9);
+}
+
+// Thickness where a curved layer's line crosses the one under it, judged on the program: a
+// line over layer 0 at (110, 100) 0.09 mm up is thinner than h_min (0.1, slack 0.001); 0.13 mm
+// up passes, and the gate's figure is what check measures on the same text.
+TEST(Gate, JudgesThicknessWhereALayerCrossesTheOneUnderIt) {
+  const SliceJob job = make_job(PrintConfig{});
+  auto text = [](double z) {
+    char buf[320];
+    std::snprintf(buf, sizeof buf,
+                  "G90\nM82\nG92 E0\n;LAYER_CHANGE\n;Z:0.2\n;HEIGHT:0.2\n;TYPE:Solid infill\n"
+                  "G1 X100 Y100 Z0.2\nG1 X120 Y100 E1\n;LAYER_CHANGE\n;Z:0.4\n;HEIGHT:0.2\n"
+                  "G1 X110 Y95 Z%.3f\nG1 X110 Y105 Z%.3f E2\n",
+                  z - 0.01, z + 0.01);
+    return std::string(buf);
+  };
+  auto run = [&](double z, Vec3* where, SliceResult* r) {
+    r->gcode = text(z);
+    auto ok = gate(*r, job, nullptr,
+                   [&](const Vec3& p, const char* w) {
+                     EXPECT_STREQ(w, "a layer crosses the one under it thinner than h_min");
+                     *where = p;
+                     return false;
+                   },
+                   {});
+    EXPECT_TRUE(ok) << ok.error().message;
+    return ok && *ok;
+  };
+  Vec3 where(0, 0, 0);
+  SliceResult thin;
+  EXPECT_FALSE(run(0.29, &where, &thin));
+  EXPECT_NEAR((where - Vec3(110, 100, 0.29)).norm(), 0, 1e-9);
+  SliceResult fine;
+  EXPECT_TRUE(run(0.33, &where, &fine));
+  EXPECT_NEAR(fine.thickness_min, 0.13, 1e-9);
+  auto moves = read_gcode_moves(fine.gcode);
+  ASSERT_TRUE(moves);
+  auto f = check_print(*moves, nullptr, job.check, {});
+  ASSERT_TRUE(f);
+  EXPECT_EQ(f->thickness_min, fine.thickness_min);
+  EXPECT_EQ(f->thickness_max, fine.thickness_max);
 }
 
 }  // namespace
