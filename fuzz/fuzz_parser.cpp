@@ -123,7 +123,12 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
 #elif NONPLANAR_FUZZ_PARSER == 6
   (void)parse_surfaces_json(in);
 #elif NONPLANAR_FUZZ_PARSER == 7
-  (void)read_gcode_moves(in);
+  // The thickness check measures on what it read (LayerGaps: grids over any coordinates).
+  if (auto moves = read_gcode_moves(in)) {
+    LayerGaps gaps;
+    for (const PrintMove& m : *moves) gaps.add(m);
+    gaps.finish();
+  }
   (void)parse_ini_config(gcode_config_block(in));  // what `check` reads of a file's settings
 #elif NONPLANAR_FUZZ_PARSER == 8
   static const Wave field;

@@ -42,8 +42,9 @@ struct MapBackParams {
   /// keep within half the margin (0.0005 mm at least), so consecutive layers' extrusions cross
   /// no closer than h_min less the gate's slack.
   double min_layer_height = 0;
-  /// Curved segments are probed this far apart (mm; 0: the midpoint only), so a dip of the
-  /// faceted top off a segment's middle still splits it (the gate measures what is left).
+  /// Curved segments whose layer is within 0.05 mm of min_layer_height are probed this far
+  /// apart (mm; 0: the midpoint only), so a dip of the faceted top off a segment's middle
+  /// still splits it (the gate measures what is left).
   double probe_spacing = 0.25;
   // Travels over curved layers (travel_height, toolhead.hpp); mm.
   double tip_radius = 0.4;   ///< the nozzle tip's flat (Toolhead::tip_radius)

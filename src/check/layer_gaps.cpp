@@ -21,6 +21,12 @@ constexpr double kDepth = 1.0;
 constexpr std::size_t kLayersKept = 24;
 // Widest bead looked for beside a crossing, mm (a layer's bbox is widened by half of it).
 constexpr double kWidest = 2.0;
+// Most cells of a grid (and at most 512 along a side): a hostile file's layer of a million
+// lines 2 km wide stays 6 MB.
+constexpr double kMostCells = 1 << 18;
+// Lines farther out than this are no print's (a broken file's), mm: left out, so a grid's
+// arithmetic stays finite.
+constexpr double kFarthest = 1e6;
 // Side of the tiles a curved layer's lines are grouped in to find the layers under them, mm.
 constexpr double kTile = 4.0;
 // Lines of two layers, one over the other, differ in height by more than this, mm.
@@ -61,8 +67,10 @@ class LayerGaps::LineGrid {
     }
     // Cells of 1 mm, coarser on a wide layer of few lines (a grid at most 4 cells per line).
     const Vec2 size = (hi_ - lo_).cwiseMax(Vec2(1e-3, 1e-3));
-    const double want = std::sqrt(size.x() * size.y() / (4.0 * static_cast<double>(ids.size())));
-    cell_ = std::max(1.0, want);
+    const double area = size.x() * size.y();
+    const double want = std::sqrt(area / (4.0 * static_cast<double>(ids.size())));
+    // At most kMostCells cells (6 MB of counts and heights), however wide or long the layer.
+    cell_ = std::max({1.0, want, std::sqrt(area / kMostCells), size.maxCoeff() / 512});
     nx_ = static_cast<int>(size.x() / cell_) + 1, ny_ = static_cast<int>(size.y() / cell_) + 1;
     start_.assign(static_cast<std::size_t>(nx_) * ny_ + 1, 0);
     for (std::size_t k : ids)
@@ -223,7 +231,9 @@ void LayerGaps::record(const CrossingGap& g) {
 }
 
 void LayerGaps::add(const PrintMove& m) {
-  if (stopped_ || !counted(m)) return;
+  if (stopped_ || !counted(m) || !(m.from.cwiseAbs().maxCoeff() <= kFarthest) ||
+      !(m.to.cwiseAbs().maxCoeff() <= kFarthest))
+    return;
   if (!current_ || current_->index != m.layer) {
     close_layer();
     current_ = std::make_unique<Layer>();

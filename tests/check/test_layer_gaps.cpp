@@ -111,5 +111,18 @@ TEST(LayerGaps, APieceMeetingItsLayerAtTheSameHeightIsNoThickness) {
   EXPECT_EQ(m.crossings, 0u);
 }
 
+TEST(LayerGaps, ALayerKilometresWideIsMeasuredOnASmallGrid) {
+  // A broken file's lines 1.8 km long and a curved one across them: a grid of 1 mm cells would
+  // be 3 × 10^12 of them; at most 512 along a side, the crossing is still exact.
+  std::vector<PrintMove> moves;
+  moves.push_back(line(0, {-9e5, 0, 0.2}, {9e5, 0, 0.2}));
+  moves.push_back(line(0, {-9e5, 1e5, 0.2}, {9e5, 1e5, 0.2}));
+  moves.push_back(line(1, {3, -1, 0.4}, {3, 1, 0.42}));
+  moves.push_back(line(1, {0, 2e6, 0.4}, {1, 2e6, 0.4}));  // past 1 km: left out
+  const Measured m = measure(moves);
+  ASSERT_EQ(m.crossings, 1u);
+  EXPECT_NEAR(m.min, 0.21, 1e-9);
+}
+
 }  // namespace
 }  // namespace nonplanar
