@@ -132,6 +132,7 @@ class LayerGaps {
   class LineGrid;
   void close_layer();
   void measure_crossings(const Layer& up, const std::vector<Layer*>& under);
+  void measure_off_plane(const Layer& up, const std::vector<Layer*>& under);
   bool cross(const Layer& up, std::size_t i, const Layer& dn, const LineGrid& g,
              const std::vector<Layer*>& under, bool first);
   static bool on_top(const Layer& dn, const std::vector<Layer*>& under, const Vec3& x, double z_dn);

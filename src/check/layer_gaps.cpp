@@ -281,17 +281,12 @@ void LayerGaps::close_layer() {
   if (window_.size() > kLayersKept) window_.pop_front();
 }
 
-// Every crossing of a line off the layer's plane, and of a planar line over such lines of
-// the layers under it, is measured. A layer's planar lines over another's are as far above
-// them as the two planes are apart: that counts once, for the highest plane under this one
-// that they cross on top (the layer before, under a curved band's planar part or a core's
-// layers; a shell's flat pieces elsewhere are not under it), and no lower one is searched.
-void LayerGaps::measure_crossings(const Layer& up, const std::vector<Layer*>& under) {
-  // A line off the plane is measured against the layer under it nearest below it there (the
-  // highest cell it passes), or the next when that one shows it no crossing on top: a chord
-  // of a curved layer lies over one layer (searched against every layer in reach, the
-  // bunny's 300 000 such lines took 20 million tests). The layers in reach are found per
-  // tile of the lines (a curved layer spans millimetres, a tile of it little).
+// A line off the plane is measured against the layer under it nearest below it there (the
+// highest cell it passes), or the next when that one shows it no crossing on top: a chord of a
+// curved layer lies over one layer (searched against every layer in reach, the bunny's
+// 300 000 such lines took 20 million tests). The layers in reach are found per tile of the
+// lines (a curved layer spans millimetres, a tile of it little).
+void LayerGaps::measure_off_plane(const Layer& up, const std::vector<Layer*>& under) {
   std::map<std::pair<int, int>, std::vector<std::size_t>> tiles;
   for (std::size_t i : up.other) {
     const Vec2 m = 0.5 * (up.lines[i].first + up.lines[i].second).head<2>();
@@ -339,6 +334,15 @@ void LayerGaps::measure_crossings(const Layer& up, const std::vector<Layer*>& un
       }
     }
   }
+}
+
+// Every crossing of a line off the layer's plane, and of a planar line over such lines of
+// the layers under it, is measured. A layer's planar lines over another's are as far above
+// them as the two planes are apart: that counts once, for the highest plane under this one
+// that they cross on top (the layer before, under a curved band's planar part or a core's
+// layers; a shell's flat pieces elsewhere are not under it), and no lower one is searched.
+void LayerGaps::measure_crossings(const Layer& up, const std::vector<Layer*>& under) {
+  measure_off_plane(up, under);
   for (std::size_t i : up.planar)
     for (Layer* dn : under)
       if (const LineGrid* g = dn->grid(false)) cross(up, i, *dn, *g, under, false);
