@@ -386,6 +386,7 @@ Expected<SliceResult> slice_rounds(const TriangleMesh& mesh, const SliceJob& job
   // a part without stacks slices planar at once.
   const bool shells = job.shells && job.engine.engine != Engine::orcaslicer;
   bool over_stacks_tried = false;
+  bool stacks_broke = false;  // the gate refused a stack: a shell then says so, not "none fits"
   for (int round = 0; round < 8; ++round) {
     bool deferred = false;
     auto r = attempt(mesh, job, pre, excluded, &offenders, shells ? &deferred : nullptr,
@@ -413,7 +414,11 @@ Expected<SliceResult> slice_rounds(const TriangleMesh& mesh, const SliceJob& job
       // largest alone; and a shell per further curved region the part stands above.
       auto shell = try_shells(
           mesh, job, pre.analysis, shells_for(mesh, pre.analysis, job),
-          [](double) { return std::string("no stack over a plane fits it"); }, 0, *r, ctx);
+          [&](double) {
+            return std::string(stacks_broke ? "its stacks broke a limit in their final paths"
+                                            : "no stack over a plane fits it");
+          },
+          0, *r, ctx);
       if (!shell) return shell.error();
       if (*shell) return done(std::move(**shell));
       const std::vector<Notice> notices = std::move(r->notices);
@@ -435,6 +440,7 @@ Expected<SliceResult> slice_rounds(const TriangleMesh& mesh, const SliceJob& job
       excluded.push_back(fb.patch);
       dropped.push_back(planar_notice(fb.patch, fb.reason));
     }
+    stacks_broke = true;
     for (const auto& [patch, why] : offenders) {
       excluded.push_back(patch);
       dropped.push_back(dropped_notice(*r, patch, why, job));

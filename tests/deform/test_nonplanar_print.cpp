@@ -465,6 +465,25 @@ TEST(NonplanarPrint, SharedWingShellAtThinLayersClearsTheTip) {
   EXPECT_GT(r->thickness_max, 0.2);
 }
 
+// The OpenSCAD heightmap: patch 0's stack meets every limit on its own grid (29.0°) but its
+// final paths hold an extrusion steeper than max_angle, so the gate refuses it and a shell
+// over both curved patches prints; the notice says why there is no stack, not "none fits".
+TEST(NonplanarPrint, SharedHeightmapSaysItsStackBrokeALimitWhenAShellPrints) {
+  const auto dir = test::shared_models();
+  if (dir.empty()) GTEST_SKIP() << "../shared/models not present";
+  auto m = load_mesh(dir / "np_openscad_example010_heightmap.stl", {}, {});
+  ASSERT_TRUE(m);
+  const Outcome o = run(m->mesh);
+  EXPECT_EQ(o.result.shell_layers, 4);
+  EXPECT_EQ(o.figures.collisions, 0u);
+  bool said = false;
+  for (const Notice& n : o.result.notices)
+    said |= n.text.find(
+                "curved shell over a planar core (its stacks broke a limit in their "
+                "final paths)") != std::string::npos;
+  EXPECT_TRUE(said);
+}
+
 TEST(NonplanarPrint, FlatTopsSlicePlanarWithANotice) {
   const Outcome o = run(test::box({0, 0, 0}, {20, 20, 10}));
   EXPECT_FALSE(o.result.nonplanar);
