@@ -92,8 +92,9 @@ Expected<CollisionFigures> find_collisions(const MoveReplay& moves, const CheckP
 
 /// One place where layer thickness was measured: where, seen from above, an extrusion crosses
 /// an earlier one that is the top of the material under it there, the height of the upper
-/// centre line over the lower one. at: the crossing, on the upper line. curved: searched
-/// (a flat layer over flat ones counts once, at its height over the highest, unsearched).
+/// centre line over the lower one. at: the crossing, on the upper line. curved: a line off its
+/// layer's plane takes part (planar lines over planar ones are the planar engine's: they count
+/// once per layer, at the distance of the two planes).
 /// spans: the two may be more than a layer apart, so it counts for the thinnest only: either
 /// line is laid across gaps by design (sparse infill over its lattice, a bridge, support), or
 /// the lower one was not printed in the layer just before (a shell's piece over a core).
@@ -107,11 +108,11 @@ struct CrossingGap {
 /// Layer thickness as the file's own lines give it (DESIGN.md §3), for check and the safety
 /// gate alike: wherever a layer's extrusion crosses, seen from above, an earlier layer's
 /// (any of the last 24, so a shell's pieces printed between a core's layers find theirs) with
-/// no other layer's line between the two within 0.15 mm, up to 1 mm under it (deeper is a
-/// bridge). The first layer, over the bed, and the skirt do not count. Exact on the chords
-/// written: a curved layer's chord that strays from its surface shows here, where a thickness
-/// taken at the points would not. Moves go in file order; `visit` (may be null) sees each gap
-/// and stops the measuring by returning false.
+/// no other layer's bead between the two (its centre line within half its width), up to 1 mm
+/// under it (deeper is a bridge). The first layer, over the bed, and the skirt do not count. Exact
+/// on the chords written: a curved layer's chord that strays from its surface shows here, where a
+/// thickness taken at the points would not. Moves go in file order; `visit` (may be null) sees each
+/// gap and stops the measuring by returning false.
 class LayerGaps {
  public:
   explicit LayerGaps(std::function<bool(const CrossingGap&)> visit = nullptr);

@@ -241,9 +241,6 @@ struct PrintMove {
   int line = 0;            ///< 1-based line in the file (0 for moves made in memory)
 };
 
-/// What check reads of a move (its type views the same text).
-PrintMove print_move(const GcodeMove& g);
-
 /// The same reading, streamed: f gets every G0/G1 in order and nothing else is kept, for a
 /// caller that wants only some moves of a large file. Returns the problems.
 std::vector<GcodeProblem> for_each_gcode_move(std::string_view text,

@@ -395,7 +395,7 @@ bool LayerGaps::cross(const Layer& up, std::size_t i, const Layer& dn, const Lin
       // over a gap by design: lines that span, and a shell's pieces over a core's stairs,
       // cross lines further down.
       const bool next = dn.index == up.index - 1 && !up.spans[i] && !dn.spans[id];
-      record({gap, x, !(first), !next});
+      record({gap, x, !first, !next});
       found = true;
     }
   });

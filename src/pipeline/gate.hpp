@@ -13,14 +13,15 @@ namespace nonplanar {
 using Violation = std::function<bool(const Vec3&, const char*)>;
 
 /// Inputs: the result about to be written (its layers), the job's limits and toolhead, the
-/// field's bands when the part has curved stacks (collisions are then looked for only near
-/// them: gate_zones.hpp; null: everywhere). Checks thickness within [h_min, h_max] on the
-/// paths' heights, then, in the program about to be written (r.gcode, made here by
-/// write_program when empty) read back by the one reader: slope within max_angle, thickness
-/// where consecutive layers' lines cross (check's LayerGaps; within the limits where a layer
-/// is curved), both with job.gate's slack, and, when something is curved, collisions with earlier layers, searched
-/// by check's own collision search. Every breach goes to `violation`. Output: false when
-/// `violation` said stop; fills r's figures. Errors: those of write_program, cancelled.
+/// field's bands when the part has curved stacks (collisions and crossings are then looked for
+/// only near them: gate_zones.hpp; null: everywhere). Checks thickness within [h_min, h_max]
+/// on the paths' heights, then, in the program about to be written (r.gcode, made here by
+/// write_program when empty) read back by the one reader: slope within max_angle, and where a
+/// curved layer's line crosses the material under it, a thickness of at least h_min (check's
+/// LayerGaps), both with job.gate's slack; and, when something is curved, collisions with
+/// earlier layers, searched by check's own collision search. Every breach goes to
+/// `violation`. Output: false when `violation` said stop; fills r's figures (the thickness
+/// ones LayerGaps'). Errors: those of write_program, cancelled.
 Expected<bool> gate(SliceResult& r, const SliceJob& job, const layers::BandedField* banded,
                     const Violation& violation, const Context& ctx);
 

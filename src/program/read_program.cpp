@@ -311,14 +311,14 @@ void Reader::move(core::Tokenizer& tok, GcodeLine& item, bool in_print) {
   p_.moves.push_back(m);
 }
 
-}  // namespace
-
 PrintMove print_move(const GcodeMove& g) {
   PrintMove m;
   m.from = g.from, m.to = g.to, m.filament = g.de, m.extruding = g.extruding();
   m.type = g.type, m.layer = g.layer, m.width = g.width, m.line = g.line;
   return m;
 }
+
+}  // namespace
 
 GcodeProgram read_gcode_program(std::string_view text) {
   GcodeProgram p;
