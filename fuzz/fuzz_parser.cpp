@@ -6,6 +6,7 @@
 #include <string_view>
 
 #include "io/readers.hpp"
+#include "layers/shell_plan.hpp"
 #include "nonplanar/check.hpp"
 #include "nonplanar/config.hpp"
 #include "nonplanar/deform.hpp"
@@ -185,9 +186,19 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   // everywhere over and around its part.
   auto plan = parse_plan_json(in);
   if (!plan) return 0;
+  const BoundingBox& b = plan->box;
+  if (!plan->shell.empty())  // a shell's plan: its fields answer over the box
+    if (auto shell = layers::parse_shell_plan_json(plan->shell, {1.5, -2.5})) {
+      const layers::ShellPathField f(*shell, shell->core.back() + shell->t);
+      for (int i = 0; i <= 4; ++i) {
+        const double x = b.min.x() - 5 + (b.size().x() + 10) * i / 4, y = b.max.y() - i;
+        const double t = f.T(x, y, 0.5 * (b.min.z() + b.max.z()));
+        if (std::isfinite(t)) (void)f.z_at(x, y, t), (void)f.z_at(x, y, 0.25);
+        (void)f.t_of_zeta(b.max.z()), (void)shell->thickness(0, x, y);
+      }
+    }
   auto field = parse_layer_field_json(plan->field, {1.5, -2.5});
   if (!field) return 0;
-  const BoundingBox& b = plan->box;
   for (int i = 0; i <= 4; ++i)
     for (int k = 0; k <= 4; ++k) {
       const double x = b.min.x() - 5 + (b.size().x() + 10) * i / 4,

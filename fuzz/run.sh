@@ -39,7 +39,7 @@ seed off "$models"/*.off
 seed ini tests/data/*.ini
 seed settings tests/data/*.ini
 seed toolhead toolheads/*.json
-seed plan tests/data/plan_small.json tests/data/plan_small_b64.json
+seed plan tests/data/plan_small.json tests/data/plan_small_b64.json tests/data/plan_shell_small.json
 seed 3mf tests/data/*.3mf
 mkdir -p "$out/corpus/macros"
 printf '%s' 'M862.3 P "[printer_model]"\n{if max_layer_z < 200}G1 Z{z_offset+min(max_layer_z+30, 200)}{else}G1 Z{max_layer_z+1}{endif}\nM104 S[temperature[0]] ; {digits(1.5,2,1)} {printer_notes=~/.*MK3.*/ ? 1 : 0}\n{elsif}' \

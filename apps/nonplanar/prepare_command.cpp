@@ -81,18 +81,33 @@ std::string quoted(const std::string& s) {
 
 void print_instructions(const std::string& out, const PreparedPart& part) {
   const PrintPlan& p = part.plan;
-  std::fprintf(stderr, "wrote %s: %s, %zu curved stack%s\n", out.c_str(), p.object.c_str(),
-               part.stacks, part.stacks == 1 ? "" : "s");
-  std::fprintf(
-      stderr,
-      "In PrusaSlicer or OrcaSlicer, open it with your own printer and filament, and keep:\n"
-      "  - layer height %s mm (set on the object) and first layer height %s mm;\n"
-      "  - variable layer height and arc fitting off; no scaling or rotating (moving is "
-      "fine);\n"
-      "  - this post-processing script (Print Settings > Output options):\n"
-      "      %s post-process --plan %s\n",
-      num(p.layer_height).c_str(), num(p.first_layer_height).c_str(), quoted(self_path()).c_str(),
-      quoted(fs::absolute(out).string()).c_str());
+  if (part.shell_layers > 0)
+    std::fprintf(stderr,
+                 "wrote %s: %s, a curved shell of %d layers over a planar core (the shell's "
+                 "layers stand above the part in the 3MF until post-process lays them on it)\n",
+                 out.c_str(), p.object.c_str(), part.shell_layers);
+  else
+    std::fprintf(stderr, "wrote %s: %s, %zu curved stack%s\n", out.c_str(), p.object.c_str(),
+                 part.stacks, part.stacks == 1 ? "" : "s");
+  std::fprintf(stderr,
+               "In PrusaSlicer or OrcaSlicer, open it with your own printer and filament, and "
+               "keep:\n");
+  if (part.shell_layers > 0)
+    std::fprintf(stderr,
+                 "  - the object's variable layer height as prepared (do not edit or reset it) "
+                 "and first layer height %s mm; arc fitting off; the object alone on the "
+                 "plate; no scaling or rotating (moving is fine);\n",
+                 num(p.first_layer_height).c_str());
+  else
+    std::fprintf(stderr,
+                 "  - layer height %s mm (set on the object) and first layer height %s mm;\n"
+                 "  - variable layer height and arc fitting off; no scaling or rotating (moving "
+                 "is fine);\n",
+                 num(p.layer_height).c_str(), num(p.first_layer_height).c_str());
+  std::fprintf(stderr,
+               "  - this post-processing script (Print Settings > Output options):\n"
+               "      %s post-process --plan %s\n",
+               quoted(self_path()).c_str(), quoted(fs::absolute(out).string()).c_str());
 }
 
 int run(const PrepareOptions& o) {
@@ -131,8 +146,14 @@ int run(const PrepareOptions& o) {
   part->plan.object = fs::path(o.mesh.model).stem().string();
   part->plan.model = fs::path(o.mesh.model).filename().string();
   Object3mf object{part->plan.object, {{"layer_height", num(part->plan.layer_height)}}};
-  auto w = write_3mf(out, part->normalized,
-                     {{"/Metadata/nonplanar_plan.json", plan_json(part->plan)}}, object);
+  std::vector<PackageFile> files{{"/Metadata/nonplanar_plan.json", plan_json(part->plan)}};
+  // A shell's core layers: PrusaSlicer's profile, and the same under the name OrcaSlicer and
+  // Bambu Studio read (their 3MF's Metadata/layer_heights_profile.txt; untested here).
+  if (!part->layer_heights_profile.empty())
+    files.insert(files.end(),
+                 {{"/Metadata/Slic3r_PE_layer_heights_profile.txt", part->layer_heights_profile},
+                  {"/Metadata/layer_heights_profile.txt", part->layer_heights_profile}});
+  auto w = write_3mf(out, part->normalized, files, object);
   finish_progress();
   if (!w) return report_error(w.error());
   report_warnings(o.mesh.model, *loaded, o.mesh.quiet);
@@ -153,7 +174,9 @@ void register_prepare(CLI::App& app, std::function<int()>* run_fn) {
       "Plan the curved layers of a model for your own slicer: write the normalised part as a\n"
       "3MF (the plan inside it) to slice in PrusaSlicer or OrcaSlicer with your profile; its\n"
       "post-processing script, 'nonplanar post-process', maps the G-code back. Give the\n"
-      "profile you will slice with (--config or presets): the plan is made for its layers.");
+      "profile you will slice with (--config or presets): the plan is made for its layers.\n"
+      "A top no stack fits prints as a curved shell over a planar core: the 3MF then holds\n"
+      "the part with the shell's layers above it, on its own layer-height profile.");
   o->mesh.add_to(*cmd);
   cmd->add_option("-o,--output", o->output,
                   "3MF file to write (atomically); a folder gets MODEL.3mf")

@@ -54,9 +54,11 @@ struct SliceJob {
   std::vector<Notice> notices;  ///< what make_job adapted (passed on to the result)
   PrintConfig print;
   bool planar_only = false;
-  /// A part with no curved stack may print as a shell over a planar core (prepare_part,
-  /// whose one slicer run cannot print a shell, turns this off).
+  /// A part with no curved stack may print as a shell over a planar core.
   bool shells = true;
+  /// Only a shell one slicer run can print with its core (prepare_part): one shell, and only
+  /// where the part stands nowhere above its top.
+  bool one_run_shells = false;
   /// Another slicer instead of the built-in engine: it slices the normalised mesh with the
   /// user's profile and its G-code is mapped back (map_foreign_gcode). Layer heights and
   /// the bed come from `print`, which must agree with that profile.

@@ -25,6 +25,15 @@ struct PrintPlan {
   Toolhead toolhead;
   std::vector<std::string> header;  ///< what is curved, for the G-code's header
   std::string field;                ///< the layer field as text (field_io.hpp)
+  /// A shell over a planar core instead of stacks (JSON text, docs/plan-format.md; empty:
+  /// none). The slicer prints the core's layers on the shell plan's boundaries, one layer
+  /// more (cut away: it only holds up the next) and the shell's layers as planes above them.
+  std::string shell;
+  /// Where the part stands, to find it again on the slicer's plate: the outline (the largest
+  /// island's contour, counter-clockwise) of the part to slice, cut at the middle of its second
+  /// layer, whose top is at anchor_z. Empty: none (the box alone places it).
+  std::vector<Vec2> anchor;
+  double anchor_z = 0;
 };
 
 /// The plan as JSON text (docs/plan-format.md).
@@ -35,20 +44,26 @@ Expected<PrintPlan> parse_plan_json(std::string_view text);
 
 /// prepare's output: the normalised part to slice, and its plan.
 struct PreparedPart {
+  /// The part to slice: for stacks, normalised; for a shell, the part itself with the
+  /// shell's normalised slab above it (from the top of the core's layers up).
   TriangleMesh normalized;
   PrintPlan plan;
   std::shared_ptr<const LayerField> field;  ///< the plan's field (plan.field as read back)
   std::vector<Notice> notices;              ///< as slice_model's (patches printed planar and why)
   std::size_t stacks = 0;                   ///< curved stacks in the plan
+  int shell_layers = 0;                     ///< a shell's curved layers (0: no shell)
+  /// PrusaSlicer's layer-height profile for the part (Slic3r_PE_layer_heights_profile.txt;
+  /// empty: none, the layers are the plan's layer_height).
+  std::string layer_heights_profile;
 };
 
 /// Inputs: the part placed on the bed, the job (its engine slices the plan to check it,
 /// retries and all, as `slice` does: the built-in one, or PrusaSlicer with the user's profile,
-/// whose paths are the ones post-process will map). Output: the normalised part and the plan
-/// of the stacks that passed. A shell over a planar core takes
-/// two slicer runs, which one post-processing step cannot give, so shells are not planned.
-/// Errors: unsupported when nothing prints curved (the message says why), those of
-/// slice_model, cancelled.
+/// whose paths are the ones post-process will map). Output: the part to slice and the plan of
+/// the stacks that passed, or of one shell over a planar core where `slice` would print one
+/// and one slicer run can (nothing of the part stands above the shell's top: the slicer
+/// prints the core's layers, then the shell's). Errors: unsupported when nothing prints curved
+/// (the message says why), those of slice_model, cancelled.
 Expected<PreparedPart> prepare_part(const TriangleMesh& placed, SliceJob job, const Context& ctx);
 
 /// What post_process_gcode did.

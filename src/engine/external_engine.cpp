@@ -128,12 +128,9 @@ std::vector<std::string> engine_shell_settings(double first_layer) {
       slab};
 }
 
-namespace {
-
-// PrusaSlicer's layer-height profile for layers ending at `tops`, then `h` up to `top`: pairs
-// (z, height) it interpolates linearly, looked up a little above each layer's bottom; each
-// layer gets two equal points (its bottom and middle), so its height is exact.
-std::string layer_profile(const std::vector<double>& tops, double h, double top) {
+// Pairs (z, height) PrusaSlicer interpolates linearly, looked up a little above each layer's
+// bottom; each layer gets two equal points (its bottom and middle), so its height is exact.
+std::string layer_height_profile(const std::vector<double>& tops, double h, double top) {
   std::string s = "object_id=1|";
   char buf[64];
   double b = 0;
@@ -148,8 +145,6 @@ std::string layer_profile(const std::vector<double>& tops, double h, double top)
   std::snprintf(buf, sizeof buf, "%.6f;%.6f\n", top, h);
   return s + buf;
 }
-
-}  // namespace
 
 namespace {
 
@@ -193,7 +188,7 @@ Expected<std::string> run_engine(const EngineParams& e, const TriangleMesh& mesh
     std::vector<double> tops;
     for (double z : run.layer_tops) tops.push_back(z - box.min.z());
     const PackageFile f{"/Metadata/Slic3r_PE_layer_heights_profile.txt",
-                        layer_profile(tops, c.slice.layer_height, top)};
+                        layer_height_profile(tops, c.slice.layer_height, top)};
     if (auto w = write_3mf(stl, mesh, {f}); !w) return w.error();
   } else if (auto w = write_stl(stl, mesh); !w) {
     return w.error();

@@ -29,6 +29,11 @@ struct EngineRun {
   double slab_layer_height = 0;
 };
 
+/// PrusaSlicer's layer-height profile (Metadata/Slic3r_PE_layer_heights_profile.txt) of the
+/// 3MF's first object: layers ending at `tops` (mm over the object's lowest point, rising),
+/// then `h` thick up to `top`. Each layer's height is exact (two equal points a layer).
+std::string layer_height_profile(const std::vector<double>& tops, double h, double top);
+
 /// The settings the shell route forces on its two runs (header lines); first_layer: the core's
 /// first layer height, mm.
 std::vector<std::string> engine_shell_settings(double first_layer);

@@ -108,11 +108,18 @@ Expected<ForeignGcode> core_with_engine(const TriangleMesh& mesh, const layers::
   core_run.layer_tops.assign(plan.core.begin() + 1, plan.core.end());
   auto core_text = run_engine(job.engine, mesh, job.print, ctx, core_run);
   if (!core_text) return core_text.error();
+  return map_shell_core(*core_text, plan, job, ctx);
+}
+
+}  // namespace
+
+Expected<ForeignGcode> map_shell_core(std::string_view core_text, const layers::ShellPlan& plan,
+                                      const EngineRoute& job, const Context& ctx) {
   const CoreClip clip(plan, 0.5 * job.print.paths.perimeter_width);
   ForeignMapOptions core_opt;
   core_opt.clip = &clip;
   const auto planar = planar_field(job.layers);
-  auto core = map_foreign_gcode(*core_text, *planar, job.map_back, ctx, core_opt);
+  auto core = map_foreign_gcode(core_text, *planar, job.map_back, ctx, core_opt);
   if (!core) {
     Error e = core.error();
     e.message = "engine G-code (core), " + e.message;
@@ -124,18 +131,17 @@ Expected<ForeignGcode> core_with_engine(const TriangleMesh& mesh, const layers::
     if (L.paths.empty()) continue;
     const auto near = std::lower_bound(plan.core.begin(), plan.core.end(), L.max_z - 2e-3);
     if (near == plan.core.end() || *near > L.max_z + 2e-3) {
-      char buf[160];
+      char buf[300];
       std::snprintf(buf, sizeof buf,
-                    "the engine's core has a layer at z = %.3f mm, not on the planned "
-                    "boundaries (did it ignore the 3MF layer-height profile?)",
+                    "the core has a layer at z = %.3f mm, not on the planned boundaries: the "
+                    "slicer did not follow the 3MF's layer-height profile, or printed supports "
+                    "on layers of their own (a shell's part cannot have supports yet)",
                     L.max_z);
       return Error{Status::unsupported, buf};
     }
   }
   return core;
 }
-
-}  // namespace
 
 Expected<EngineShell> shell_with_engine(const TriangleMesh& mesh, const layers::ShellPlan& plan,
                                         const EngineRoute& job, const Context& ctx) {
@@ -165,13 +171,20 @@ Expected<EngineShell> shell_with_engine(const TriangleMesh& mesh, const layers::
   if (!core) return core.error();
   if (!shell_text) return shell_text.error();
   ctx.progress("core", 1.0);
+  return join_shell(std::move(*core), *shell_text, plan, 0.0, job,
+                    "the shell's curved layers, from the engine's second run", ctx);
+}
+
+Expected<EngineShell> join_shell(ForeignGcode core, std::string_view shell_text,
+                                 const layers::ShellPlan& plan, double base, const EngineRoute& job,
+                                 const std::string& note, const Context& ctx) {
   // Entered from where the core ended.
-  const layers::ShellPathField path_field(plan);
+  const layers::ShellPathField path_field(plan, base);
   ctx.progress("map back", 0);
   ForeignMapOptions shell_opt;
-  shell_opt.start = core->end_at;
-  shell_opt.start_retracted = core->retracted;
-  auto shell = map_foreign_gcode(*shell_text, path_field, job.map_back, ctx, shell_opt);
+  shell_opt.start = core.end_at;
+  shell_opt.start_retracted = core.retracted;
+  auto shell = map_foreign_gcode(shell_text, path_field, job.map_back, ctx, shell_opt);
   if (!shell) {
     Error e = shell.error();
     e.message = "engine G-code (shell), " + e.message;
@@ -180,10 +193,10 @@ Expected<EngineShell> shell_with_engine(const TriangleMesh& mesh, const layers::
 
   // Stitch: the core's start and print, the shell's print, the core's end.
   EngineShell out;
-  out.gcode.reserve(core->start.size() + core->print.size() + shell->print.size() +
-                    core->end.size() + 256);
-  out.gcode.append(core->start).append(core->print);
-  out.gcode += "; nonplanar: the shell's curved layers, from the engine's second run\n";
+  out.gcode.reserve(core.start.size() + core.print.size() + shell->print.size() + core.end.size() +
+                    256);
+  out.gcode.append(core.start).append(core.print);
+  out.gcode += "; nonplanar: " + note + "\n";
   out.gcode += shell->relative_e_at_print ? "M83\n" : "M82\n";
   if (!shell->fan_at_print.empty()) out.gcode += shell->fan_at_print + "\n";
   char buf[64];
@@ -193,9 +206,9 @@ Expected<EngineShell> shell_with_engine(const TriangleMesh& mesh, const layers::
   }
   out.gcode.append(shell->print);
   out.gcode += "; nonplanar: the core run's end G-code\n";
-  out.gcode += core->relative_e_at_end ? "M83\n" : "M82\n";
-  out.gcode.append(core->end);
-  out.layers = std::move(core->layers);
+  out.gcode += core.relative_e_at_end ? "M83\n" : "M82\n";
+  out.gcode.append(core.end);
+  out.layers = std::move(core.layers);
   for (LayerToolpaths& L : shell->layers) out.layers.push_back(std::move(L));
   return out;
 }

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "engine/engine_route.hpp"
@@ -29,5 +30,19 @@ TriangleMesh cut_below(const TriangleMesh& mesh, double z0);
 /// first-layer settings neutral). Errors: those of the engine and the mapping; cancelled.
 Expected<EngineShell> shell_with_engine(const TriangleMesh& mesh, const layers::ShellPlan& plan,
                                         const EngineRoute& job, const Context& ctx);
+
+/// The core's G-code (a planar program sliced on plan.core's boundaries) mapped and cut back
+/// under the shell, as shell_with_engine maps its first run. Errors: those of the mapping, and
+/// unsupported for a layer off the planned boundaries (the profile was not followed).
+Expected<ForeignGcode> map_shell_core(std::string_view core_text, const layers::ShellPlan& plan,
+                                      const EngineRoute& job, const Context& ctx);
+
+/// Inputs: the mapped core, the shell's G-code (its layers planes of ShellField(plan, base)),
+/// the note written where the shell begins. Output: one program: the core's start and layers,
+/// the shell's layers mapped onto the shell (entered from where the core ended, its retraction
+/// given back; its fan as the shell's program had it when its print began), the core's end.
+Expected<EngineShell> join_shell(ForeignGcode core, std::string_view shell_text,
+                                 const layers::ShellPlan& plan, double base, const EngineRoute& job,
+                                 const std::string& note, const Context& ctx);
 
 }  // namespace nonplanar

@@ -9,6 +9,7 @@
 
 #include "core/base64.hpp"
 #include "layers/banded_field.hpp"
+#include "layers/shell_plan.hpp"
 #include "nonplanar/field_io.hpp"
 #include "nonplanar/surface_io.hpp"
 
@@ -227,4 +228,58 @@ Expected<std::shared_ptr<const LayerField>> parse_layer_field_json(std::string_v
   }
 }
 
+namespace layers {
+
+std::string shell_plan_json(const ShellPlan& s) {
+  ordered_json top = raster(s.top.origin, s.top.cell, s.top.nx, s.top.ny, s.top.h);
+  top["h_lo"] = s.top.h_lo, top["h_hi"] = s.top.h_hi;
+  ordered_json j = {
+      {"patches", s.patches},
+      {"N", s.N},
+      {"t", s.t},
+      {"reach", s.reach},
+      {"core", {{"count", s.core.size()}, {"values", doubles_b64(s.core.data(), s.core.size())}}},
+      {"top", std::move(top)}};
+  return j.dump();
+}
+
+Expected<ShellPlan> parse_shell_plan_json(std::string_view text, const Vec2& shift) {
+  if (!shift.allFinite()) return Error{Status::invalid_argument, "shell: shift is not finite"};
+  const json j = json::parse(text.begin(), text.end(), nullptr, false);
+  if (j.is_discarded() || !j.is_object())
+    return Error{Status::parse_error, "shell: not a JSON object"};
+  ShellPlan s;
+  try {
+    const json& patches = j.at("patches");
+    if (!patches.is_array() || patches.size() > 10000) fail("patches must be a list");
+    for (const json& p : patches) {
+      if (!p.is_number_integer() || p.get<std::int64_t>() < 0 || p.get<std::int64_t>() > 1000000)
+        fail("patches must be patch numbers");
+      s.patches.push_back(p.get<int>());
+    }
+    s.N = count(j, "N", 1000);
+    if (s.N < 1) fail("N must be at least 1");
+    s.t = number(j, "t");
+    if (!(s.t >= 0.01 && s.t <= 10)) fail("t must lie in [0.01, 10] mm");
+    s.reach = number(j, "reach");
+    if (!(s.reach >= 0 && s.reach < s.t)) fail("reach must lie in [0, t)");
+    const json& core = j.at("core");
+    const int n = count(core, "count", kMaxLayers);
+    s.core = numbers(core.at("values"), static_cast<std::size_t>(n), "core");
+    if (n < 2 || s.core.front() != 0) fail("core must run from 0 over one layer at least");
+    for (int k = 1; k < n; ++k)
+      if (!(s.core[k] > s.core[k - 1] && s.core[k] < 1e4)) fail("core must rise, below 10 m");
+    const json& top = j.at("top");
+    read_raster(top, shift, &s.top.origin, &s.top.cell, &s.top.nx, &s.top.ny, &s.top.h);
+    if (s.top.nx < 2 || s.top.ny < 2) fail("top raster needs 2 x 2 nodes at least");
+    s.top.h_lo = number(top, "h_lo"), s.top.h_hi = number(top, "h_hi");
+    for (double h : s.top.h)
+      if (std::abs(h) > 1e4) fail("top heights must lie within 10 m");
+  } catch (const std::exception& e) {
+    return Error{Status::parse_error, std::string("shell: ") + e.what()};
+  }
+  return s;
+}
+
+}  // namespace layers
 }  // namespace nonplanar

@@ -252,8 +252,15 @@ ShellPlan plan_shell(const TriangleMesh& mesh, const Analysis& a, const std::vec
     if (q.verdict == PatchVerdict::flat && q.z_max - q.z_min < 0.05)
       targets.push_back(0.5 * (q.z_min + q.z_max));  // the wing's tilted floor: 3.55–3.58 mm
   if (!s.region.empty()) end = box.max.z();          // the part outside R goes on above the shell
-  s.core =
-      core_boundaries(std::min(p.first_layer_height, h_c), h_c, p.min_layer_height, end, targets);
+  // The first layer is the profile's where no stair of the shell's lowest layer comes down to
+  // it (B + a >= z_1 all over H's raster: the layer over a stair is z_{k+1} − z_k thick, and
+  // the first layer is never that one): a slicer that slices the core in the same run as the
+  // shell (prepare) prints its own first layer height. Else at most h_c, as every stair.
+  double lowest = 1e300;
+  for (double h : s.top.h) lowest = std::min(lowest, h - s.N * s.t + s.reach);
+  const double h1 = lowest >= p.first_layer_height + 1e-6 ? p.first_layer_height
+                                                          : std::min(p.first_layer_height, h_c);
+  s.core = core_boundaries(h1, h_c, p.min_layer_height, end, targets);
   return s;
 }
 

@@ -18,6 +18,7 @@
 #include <algorithm>
 #include <limits>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "layers/faceted_top.hpp"
@@ -93,25 +94,28 @@ ShellPlan choose_shell(const TriangleMesh& mesh, const Analysis& a, const LayerP
 std::vector<ShellPlan> choose_shells(const TriangleMesh& mesh, const Analysis& a,
                                      const LayerParams& p, int most = 4);
 
-/// The shell's layer field: T = N + (z − H)/t, ζ = t·T, so the normalised mesh holds the
-/// shell's layers as planes ζ = j·t … (j + 1)·t. Every column is curved.
+/// The shell's layer field: T = N + (z − H)/t, ζ = base + t·T, so the normalised mesh holds
+/// the shell's layers as planes ζ = base + j·t … base + (j + 1)·t. Every column is curved.
+/// base (mm) lifts the normalised shell: 0 for a slab on the bed (an engine's run of its
+/// own), the top of the core's layers when one slicer run prints both (prepare).
 class ShellField : public LayerField {
  public:
-  explicit ShellField(const ShellPlan& plan) : s_(plan) {}
+  explicit ShellField(const ShellPlan& plan, double base = 0) : s_(plan), base_(base) {}
   double T(double x, double y, double z) const override {
     return s_.N + (z - s_.top.height(x, y)) / s_.t;
   }
   double z_at(double x, double y, double t) const override {
     return s_.top.height(x, y) + (t - s_.N) * s_.t;
   }
-  double zeta(double t) const override { return t * s_.t; }
-  double t_of_zeta(double z) const override { return z / s_.t; }
+  double zeta(double t) const override { return base_ + t * s_.t; }
+  double t_of_zeta(double z) const override { return (z - base_) / s_.t; }
   double thickness(double, double, double) const override { return s_.t; }
   bool planar_at(double, double) const override { return false; }
   bool planar_along(const Vec2&, const Vec2&, double, double) const override { return false; }
 
  protected:
   const ShellPlan& s_;
+  double base_ = 0;
 };
 
 /// ShellField for mapping the shell's toolpaths back: its lowest boundary (t = 0) is the core's
@@ -124,5 +128,12 @@ class ShellPathField final : public ShellField {
     return t < 0.5 ? std::max(s_.core_top(x, y), 0.0) : ShellField::z_at(x, y, t);
   }
 };
+
+/// The plan of a shell that prints where nothing stands above its top (region empty) as JSON
+/// (docs/plan-format.md, "shell"): H's raster, N, t, the reach and the core's boundaries.
+std::string shell_plan_json(const ShellPlan& plan);
+/// Reads what shell_plan_json wrote, H moved by `shift` in XY (mm); every value checked.
+/// Errors: parse_error saying what is wrong.
+Expected<ShellPlan> parse_shell_plan_json(std::string_view text, const Vec2& shift = {0, 0});
 
 }  // namespace nonplanar::layers

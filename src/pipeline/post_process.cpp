@@ -1,12 +1,15 @@
-// prepare_part and post_process_gcode (print_plan.hpp): the slicer's own route, split at its
-// post-processing hook.
+// post_process_gcode (print_plan.hpp): the slicer's own route, after its post-processing hook.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <map>
+#include <optional>
 
+#include "core/polygon_ops.hpp"
+#include "engine/shell_engine.hpp"
+#include "layers/shell_plan.hpp"
 #include "nonplanar/config.hpp"
 #include "nonplanar/field_io.hpp"
 #include "nonplanar/print_plan.hpp"
@@ -14,41 +17,6 @@
 #include "pipeline/gate.hpp"
 
 namespace nonplanar {
-
-Expected<PreparedPart> prepare_part(const TriangleMesh& placed, SliceJob job, const Context& ctx) {
-  job.shells = false;
-  auto r = slice_model(placed, job, ctx);
-  if (!r) return r.error();
-  if (r->plan.stacks.empty() || !r->plan.field) {
-    std::string why = "no surface needs curved layers";
-    for (const Notice& n : r->notices)
-      if (n.kind == Notice::Kind::summary) why = n.text;
-    return Error{Status::unsupported,
-                 "nothing prints curved, so there is nothing to prepare (" + why +
-                     "); slice it as it is ('nonplanar slice' may still print its top as a "
-                     "curved shell over a planar core, which one slicer run cannot)"};
-  }
-  auto normalized = normalize_mesh(placed, *r->plan.field, {}, ctx);
-  if (!normalized) return normalized.error();
-  auto field = layer_field_json(*r->plan.field);
-  if (!field) return field.error();
-  PreparedPart out;
-  out.normalized = std::move(normalized->mesh);
-  out.notices = std::move(r->notices);
-  out.stacks = r->plan.stacks.size();
-  out.field = r->plan.field;
-  PrintPlan& p = out.plan;
-  p.box = bounding_box(out.normalized);
-  p.layer_height = job.layers.layer_height;
-  p.first_layer_height = job.layers.first_layer_height;
-  p.min_layer_height = job.layers.min_layer_height;
-  p.max_layer_height = job.layers.max_layer_height;
-  p.max_angle_deg = job.layers.max_angle_deg;
-  p.toolhead = job.layers.toolhead;
-  p.header = r->header;
-  p.field = std::move(*field);
-  return out;
-}
 
 namespace {
 
@@ -155,7 +123,8 @@ std::optional<Error> settings_kept(const GcodeProgram& prog, const std::vector<c
       if (first < 0) first = prog.moves[i].layer;
       last = std::max(last, prog.moves[i].layer);
     }
-  for (std::size_t i = 0; i < prog.moves.size(); ++i) {
+  // A shell's layers are its plan's core boundaries, then its own (shell_split checks them).
+  for (std::size_t i = 0; i < prog.moves.size() && plan.shell.empty(); ++i) {
     const GcodeMove& m = prog.moves[i];
     if (of_part(i) && m.layer > first && m.layer < last &&
         std::abs(m.height - plan.layer_height) > 1e-3) {
@@ -174,6 +143,68 @@ std::optional<Error> settings_kept(const GcodeProgram& prog, const std::vector<c
   if (block_value(block, "spiral_vase") == "1")
     return refuse("spiral_vase = 1: a spiral vase has no layers to map; switch it off");
   return std::nullopt;
+}
+
+// A closed loop's area centroid (shoelace), and its signed area in *a.
+Vec2 centroid(const std::vector<Vec2>& loop, double* a) {
+  double twice = 0;
+  Vec2 c(0, 0);
+  for (std::size_t i = 0; i < loop.size(); ++i) {
+    const Vec2& p = loop[i];
+    const Vec2& q = loop[(i + 1) % loop.size()];
+    const double cross = p.x() * q.y() - q.x() * p.y();
+    twice += cross, c += (p + q) * cross;
+  }
+  *a = 0.5 * twice;
+  return twice != 0 ? Vec2(c / (3 * twice)) : c;
+}
+
+// Where the slicer put the part, to a hundredth of a millimetre where the box is off by a
+// tenth (a wing's trailing edge: its outer perimeter stops short of the thin end, and the
+// box's centre moved 0.08 mm): the centroid of the largest loop of outer perimeter in the
+// plan's anchor layer against the anchor's, inset by half that perimeter's width as the
+// slicer insets it. None when the layer or a loop is missing.
+std::optional<Vec2> anchored(const GcodeProgram& prog, const std::vector<char>& ours,
+                             const PrintPlan& plan) {
+  if (plan.anchor.size() < 3) return std::nullopt;
+  int layer = -1;
+  for (std::size_t k = 0; k < prog.layer_z.size() && layer < 0; ++k)
+    if (std::abs(prog.layer_z[k] - plan.anchor_z) < 2e-3) layer = static_cast<int>(k);
+  std::vector<Vec2> loop, best;
+  double best_area = 0, width = 0, best_width = 0;
+  const auto close = [&] {
+    double a = 0;
+    if (loop.size() >= 3) centroid(loop, &a);
+    if (std::abs(a) > best_area) best_area = std::abs(a), best = loop, best_width = width;
+    loop.clear();
+  };
+  for (std::size_t i = 0; i < prog.moves.size() && layer >= 0; ++i) {
+    const GcodeMove& m = prog.moves[i];
+    if (m.layer != layer) {
+      if (m.layer > layer) break;
+      continue;
+    }
+    const Vec2 from = m.from.head<2>(), to = m.to.head<2>();
+    if (ours[i] && m.extruding() && outline(m.type)) {
+      if (!loop.empty() && (loop.back() - from).norm() > 1e-3) close();
+      if (loop.empty()) loop.push_back(from);
+      loop.push_back(to), width = m.width;
+    } else if (!m.extruding() && (to - from).norm() > 1e-3) {
+      close();
+    }
+  }
+  close();
+  if (best_area <= 0) return std::nullopt;
+  double most = 0;
+  Vec2 want(0, 0);
+  for (const ExPolygon& e : clip::offset_ex({ExPolygon{plan.anchor, {}}}, -0.5 * best_width)) {
+    double a = 0;
+    const Vec2 c = centroid(e.contour, &a);
+    if (std::abs(a) > most) most = std::abs(a), want = c;
+  }
+  double unused = 0;
+  if (most <= 0) return std::nullopt;
+  return Vec2(centroid(best, &unused) - want);
 }
 
 // Where the slicer put the part: the box of its outline (its outer perimeters; without any,
@@ -205,6 +236,7 @@ Expected<Vec2> placement(const GcodeProgram& prog, const std::vector<char>& ours
                     got.x(), got.y(), want.x(), want.y());
       return refuse(buf);
     }
+  if (auto at = anchored(prog, ours, plan)) return *at;
   return Vec2(0.5 * (b.min + b.max).head<2>() - 0.5 * (plan.box.min + plan.box.max).head<2>());
 }
 
@@ -238,6 +270,78 @@ Expected<std::vector<char>> moves_of_part(const GcodeProgram& prog, const PrintP
   return ours;
 }
 
+// Where a shell plan's G-code splits (prepare_shell in prepare_part.cpp): the core's layers,
+// with tops on the plan's boundaries up to z_s; the layer z_s … z_s + t that held the shell's
+// slab up (cut away); the shell's layers, t thick. Byte offsets into the file.
+struct ShellSplit {
+  std::size_t print_begin = 0, plate = 0, shell = 0, print_end = 0;
+  std::size_t first_move = 0;  ///< the shell's first layer's first move (its header before it)
+  double e = 0;                ///< the file's E where the shell's first layer begins
+  double retracted = 0;        ///< filament the print's own moves have pulled back there, mm
+  bool relative_e = false;
+  std::string fan;  ///< the last M106/M107 before it ("" when none)
+};
+
+Expected<ShellSplit> shell_split(const GcodeProgram& prog, std::string_view gcode,
+                                 const PrintPlan& plan) {
+  auto shell = layers::parse_shell_plan_json(plan.shell);
+  if (!shell) return shell.error();
+  const double z_s = shell->core.back(), t = shell->t;
+  const auto& z = prog.layer_z;
+  std::size_t k = 0;
+  while (k < z.size() && z[k] <= z_s + 2e-3) ++k;
+  char buf[320];
+  if (k + 1 >= z.size() || std::abs(z[k] - (z_s + t)) > 2e-3) {
+    std::snprintf(buf, sizeof buf,
+                  "no layer ends at z = %.3f mm, where the plan's shell begins: keep the object's "
+                  "layer-height profile as prepared (variable layer height untouched)",
+                  z_s + t);
+    return refuse(buf);
+  }
+  for (std::size_t q = k + 1; q + 1 < z.size(); ++q) {
+    const double j = (z[q] - z_s) / t;
+    if (std::abs(j - std::round(j)) > 0.01) {
+      std::snprintf(buf, sizeof buf,
+                    "layer %zu ends at z = %.3f mm, not on the plan's shell layers (%.3f mm "
+                    "thick from %.3f): keep the object's layer-height profile as prepared",
+                    q + 1, z[q], t, z_s);
+      return refuse(buf);
+    }
+  }
+  ShellSplit out;
+  const auto at = [&](std::size_t line) {
+    return line < prog.lines.size()
+               ? static_cast<std::size_t>(prog.lines[line].raw.data() - gcode.data())
+               : gcode.size();
+  };
+  out.print_begin = at(prog.print_begin), out.print_end = at(prog.print_end);
+  out.relative_e = prog.at_print.relative_e;
+  double e = prog.at_print.e;
+  using Kind = GcodeLine::Kind;
+  for (std::size_t i = prog.print_begin; i < prog.print_end; ++i) {
+    const GcodeLine& l = prog.lines[i];
+    if (l.layer == static_cast<int>(k) && out.plate == 0) out.plate = at(i);
+    if (l.layer == static_cast<int>(k) + 1) {
+      if (out.shell == 0) out.shell = at(i), out.e = e;
+      if (l.kind == Kind::move) {
+        out.first_move = at(i);
+        break;
+      }
+      continue;
+    }
+    if (l.kind == Kind::e_reset) e = l.value;
+    if (l.kind == Kind::e_mode) out.relative_e = l.value != 0;
+    if (l.kind == Kind::text && (l.raw.rfind("M106", 0) == 0 || l.raw.rfind("M107", 0) == 0))
+      out.fan = std::string(l.raw);
+    if (l.kind != Kind::move) continue;
+    const GcodeMove& m = prog.moves[static_cast<std::size_t>(l.move)];
+    e += m.de;
+    if (!m.extruding() && m.has_e) out.retracted -= m.de;
+  }
+  if (out.first_move == 0) return refuse("the shell's layers hold no move");
+  return out;
+}
+
 // What the file must keep of the plan (settings_kept), where the part went (placement), and
 // which moves are other objects' (kept planar). Its own reading of the file is gone when it
 // returns: map_foreign_gcode reads the file again, and the bunny's 14.7 MB file read twice
@@ -245,6 +349,7 @@ Expected<std::vector<char>> moves_of_part(const GcodeProgram& prog, const PrintP
 struct Checked {
   Vec2 moved{0, 0};
   ForeignMapOptions options;
+  std::optional<ShellSplit> split;  ///< a shell plan's
 };
 Expected<Checked> checked_placement(std::string_view gcode, const std::string& block,
                                     const PrintPlan& plan) {
@@ -262,6 +367,15 @@ Expected<Checked> checked_placement(std::string_view gcode, const std::string& b
   if (auto e = settings_kept(prog, *ours, block, plan)) return *e;
   Checked c;
   c.moved = *moved;
+  if (!plan.shell.empty()) {
+    // The core's layers end where the shell's begin, for every object on the plate alike.
+    if (std::find(ours->begin(), ours->end(), 0) != ours->end())
+      return refuse("a shell over a planar core prints alone: the plate holds other objects");
+    auto split = shell_split(prog, gcode, plan);
+    if (!split) return split.error();
+    c.split = std::move(*split);
+    return c;
+  }
   if (std::find(ours->begin(), ours->end(), 0) != ours->end()) {
     c.options.planar_lines.assign(prog.lines.size(), 0);
     for (std::size_t i = 0; i < prog.moves.size(); ++i)
@@ -269,6 +383,46 @@ Expected<Checked> checked_placement(std::string_view gcode, const std::string& b
         c.options.planar_lines[static_cast<std::size_t>(prog.moves[i].line - 1)] = 1;
   }
   return c;
+}
+
+// A shell plan's G-code mapped as the engine route maps its two runs: the core's layers (the
+// file without the shell's and the layer under them) cut back under the shell; the shell's
+// layers (after the file's start G-code, the E, fan and retraction the file had when they
+// began) mapped onto the shell; joined.
+Expected<EngineShell> map_shell_gcode(std::string_view gcode, const ShellSplit& sp,
+                                      const PrintPlan& plan, const Vec2& moved, const SliceJob& job,
+                                      const Context& ctx) {
+  auto shell = layers::parse_shell_plan_json(plan.shell, moved);
+  if (!shell) return shell.error();
+  std::string core_text;
+  core_text.reserve(sp.plate + gcode.size() - sp.print_end);
+  core_text.append(gcode.substr(0, sp.plate)).append(gcode.substr(sp.print_end));
+  std::string shell_text(gcode.substr(0, sp.print_begin));
+  char buf[96];
+  if (!sp.relative_e) {
+    std::snprintf(buf, sizeof buf, "G92 E%.5f\n", sp.e + sp.retracted);
+    shell_text += buf;
+  }
+  if (!sp.fan.empty()) shell_text += sp.fan + "\n";
+  shell_text.append(gcode.substr(sp.shell, sp.first_move - sp.shell));
+  if (std::abs(sp.retracted) > 1e-6) {
+    std::snprintf(buf, sizeof buf, "G1 E%.5f F2100\n", sp.relative_e ? -sp.retracted : sp.e);
+    shell_text += buf;
+  }
+  shell_text.append(gcode.substr(sp.first_move));
+  const EngineRoute route{job.engine, job.print, job.layers, job.map_back};
+  auto core = map_shell_core(core_text, *shell, route, ctx);
+  if (!core) return core.error();
+  return join_shell(std::move(*core), shell_text, *shell, shell->core.back() + shell->t, route,
+                    "the shell's curved layers, from the slicer's layers above the core", ctx);
+}
+
+// Whether our mark heads our header, which the time estimate's first M73 lines may precede (a
+// profile with remaining_times, as the MK3S's): looked for before the first layer.
+bool post_processed(std::string_view gcode) {
+  const std::string_view head = gcode.substr(0, gcode.find("\n;LAYER_CHANGE"));
+  return head.substr(0, kPostProcessedMark.size()) == kPostProcessedMark ||
+         head.find("\n" + std::string(kPostProcessedMark)) != std::string_view::npos;
 }
 
 }  // namespace
@@ -291,7 +445,7 @@ std::vector<std::string> gcode_object_names(std::string_view gcode) {
 
 Expected<PostProcessed> post_process_gcode(std::string_view gcode, const PrintPlan& plan,
                                            const Context& ctx) {
-  if (gcode.substr(0, kPostProcessedMark.size()) == kPostProcessedMark)
+  if (post_processed(gcode))
     return refuse("already post-processed by nonplanar (mapping it twice would lift it twice)");
   const std::string block = gcode_config_block(gcode);
   if (block.empty())
@@ -312,11 +466,19 @@ Expected<PostProcessed> post_process_gcode(std::string_view gcode, const PrintPl
   SliceJob job = make_job(*cfg, plan.max_angle_deg);
   auto field = parse_layer_field_json(plan.field, moved);
   if (!field) return field.error();
-  const ForeignMapOptions& options = checked->options;
-  auto mapped = map_foreign_gcode(gcode, **field, job.map_back, ctx, options);
-  if (!mapped) return mapped.error();
   SliceResult r;
-  r.layers = std::move(mapped->layers);
+  std::string body;
+  if (checked->split) {
+    auto joined = map_shell_gcode(gcode, *checked->split, plan, moved, job, ctx);
+    if (!joined) return joined.error();
+    r.layers = std::move(joined->layers);
+    body = std::move(joined->gcode);
+  } else {
+    auto mapped = map_foreign_gcode(gcode, **field, job.map_back, ctx, checked->options);
+    if (!mapped) return mapped.error();
+    r.layers = std::move(mapped->layers);
+    body = mapped->take_text();
+  }
   r.nonplanar = true;
   char buf[240];
   std::snprintf(buf, sizeof buf, "%s %s from %s (plan of %s; the part moved by %.3f, %.3f mm)\n",
@@ -324,10 +486,10 @@ Expected<PostProcessed> post_process_gcode(std::string_view gcode, const PrintPl
                 moved.x(), moved.y());
   std::string head = buf;
   for (const std::string& h : plan.header) head += "; " + h + "\n";
-  r.gcode = head + mapped->take_text();
+  r.gcode = head + body;
   std::string breach;
   auto ok = gate(
-      r, job, dynamic_cast<const layers::BandedField*>(field->get()),
+      r, job, checked->split ? nullptr : dynamic_cast<const layers::BandedField*>(field->get()),
       [&](const Vec3& p, const char* what) {
         std::snprintf(buf, sizeof buf, "%s at (%.2f, %.2f, %.2f)", what, p.x(), p.y(), p.z());
         breach = buf;

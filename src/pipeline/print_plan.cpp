@@ -110,6 +110,12 @@ std::string plan_json(const PrintPlan& p) {
                     {"toolhead", toolhead_json(p.toolhead)},
                     {"header", p.header},
                     {"field", ordered_json::parse(p.field)}};
+  if (!p.shell.empty()) j["shell"] = ordered_json::parse(p.shell);
+  if (!p.anchor.empty()) {
+    ordered_json contour = ordered_json::array();
+    for (const Vec2& q : p.anchor) contour.push_back({q.x(), q.y()});
+    j["anchor"] = {{"z", p.anchor_z}, {"contour", std::move(contour)}};
+  }
   return j.dump(1) + "\n";
 }
 
@@ -144,6 +150,22 @@ Expected<PrintPlan> parse_plan_json(std::string_view in) {
     }
     if (!j.at("field").is_object()) fail("field must be an object");
     p.field = j.at("field").dump();
+    if (j.contains("anchor")) {
+      const json& a = j.at("anchor");
+      p.anchor_z = number(a, "z", 0, 1e5);
+      const json& c = a.at("contour");
+      if (!c.is_array() || c.size() < 3 || c.size() > 1000000)
+        fail("anchor contour must be a list of 3 points or more");
+      for (const json& q : c) {
+        if (!q.is_array() || q.size() != 2) fail("anchor points must be [x, y]");
+        const Vec3 v = vec3(json::array({q[0], q[1], 0}));
+        p.anchor.emplace_back(v.x(), v.y());
+      }
+    }
+    if (j.contains("shell")) {
+      if (!j.at("shell").is_object()) fail("shell must be an object");
+      p.shell = j.at("shell").dump();
+    }
   } catch (const std::exception& e) {
     return Error{Status::parse_error, e.what()};
   }

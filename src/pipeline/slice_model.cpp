@@ -180,10 +180,12 @@ std::vector<int> shell_patches(const std::vector<layers::ShellPlan>& shells) {
   return all;
 }
 
-// layers::choose_shells, one shell only through an external engine (its two runs take one).
+// layers::choose_shells, one shell only through an external engine (its two runs take one)
+// or for one slicer run (prepare).
 std::vector<layers::ShellPlan> shells_for(const TriangleMesh& mesh, const Analysis& a,
                                           const SliceJob& job) {
-  return layers::choose_shells(mesh, a, job.layers, job.engine.engine == Engine::builtin ? 4 : 1);
+  const bool several = job.engine.engine == Engine::builtin && !job.one_run_shells;
+  return layers::choose_shells(mesh, a, job.layers, several ? 4 : 1);
 }
 
 // The header lines and notices of the shells printed (r's), from the planar attempt's.
@@ -245,6 +247,14 @@ Expected<std::optional<SliceResult>> try_shell(const TriangleMesh& mesh, const S
   };
   if (!plan.refused.empty()) {
     planar.notices.push_back(refused(plan.refused));
+    return std::optional<SliceResult>{};
+  }
+  // The slicer prints the core's layers, then the shell's above them: it cannot go back to
+  // the core after the shell, as printing beside what stands above the top needs.
+  if (job.one_run_shells && !plan.region.empty()) {
+    planar.notices.push_back(
+        refused("in one slicer run a shell prints only where the part stands nowhere above its top "
+                "('nonplanar slice' prints this one)"));
     return std::optional<SliceResult>{};
   }
   SliceResult r;

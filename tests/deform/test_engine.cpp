@@ -148,7 +148,7 @@ TEST(EnginePrusaSlicer, ACoreOffThePlannedBoundariesFallsBackToPlanar) {
   EXPECT_EQ(r->shell_layers, 0);
   EXPECT_FALSE(r->nonplanar);
   const bool said = std::any_of(r->notices.begin(), r->notices.end(), [](const Notice& n) {
-    return n.text.find("not printed as a shell: the engine's core has a layer at z = 0.300") !=
+    return n.text.find("not printed as a shell: the core has a layer at z = 0.300") !=
            std::string::npos;
   });
   EXPECT_TRUE(said);

@@ -4,10 +4,12 @@
 // (tests/cli/test_post_process.cpp runs the real one).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <random>
 
+#include "layers/shell_plan.hpp"
 #include "nonplanar/check.hpp"
 #include "nonplanar/field_io.hpp"
 #include "nonplanar/print_plan.hpp"
@@ -165,6 +167,10 @@ TEST(PostProcess, MapsTheSlicersGcodeAsTheEngineRouteDoes) {
   auto again = post_process_gcode(out->gcode, d.part.plan, {});
   ASSERT_FALSE(again);
   EXPECT_NE(again.error().message.find("already post-processed"), std::string::npos);
+  // Also under the time estimate's first lines (a profile with remaining_times, the MK3S's).
+  auto timed = post_process_gcode("M73 P0 R86\nM73 Q0 S86\n" + out->gcode, d.part.plan, {});
+  ASSERT_FALSE(timed);
+  EXPECT_NE(timed.error().message.find("already post-processed"), std::string::npos);
 }
 
 TEST(PostProcess, APartMovedOnThePlateIsFollowed) {
@@ -249,6 +255,57 @@ TEST(PostProcess, ObjectLabelsNameTheParts) {
                                    "plan's"),
             std::string::npos)
       << r.error().message;
+}
+
+// A part whose top prints as a shell over a planar core (the rib over a void): the part as it
+// is with the shell's slab above it, on layers that end on the core's boundaries and then every
+// t; the plan's shell reads back bit for bit, moved with the part.
+TEST(PrintPlan, AShellIsPreparedAsThePartWithItsSlabAbove) {
+  const TriangleMesh rib = test::placed(test::rib(), PrintConfig{});
+  auto part = prepare_part(rib, make_job(PrintConfig{}), {});
+  ASSERT_TRUE(part) << part.error().message;
+  ASSERT_GT(part->shell_layers, 0);
+  auto shell = layers::parse_shell_plan_json(part->plan.shell);
+  ASSERT_TRUE(shell) << shell.error().message;
+  EXPECT_EQ(shell->N, part->shell_layers);
+  const double z_s = shell->core.back(), t = shell->t;
+  // The rib below, the slab (the layer under the shell, then its N) from z_s up.
+  const BoundingBox part_box = bounding_box(rib), box = bounding_box(part->normalized);
+  EXPECT_LT(z_s, part_box.max.z());
+  EXPECT_NEAR(box.max.z(), z_s + (shell->N + 1) * t, 0.03);
+  EXPECT_NEAR(box.min.x(), part_box.min.x(), 1e-9);
+  EXPECT_NEAR(box.max.y(), part_box.max.y(), 1e-9);
+  EXPECT_EQ(part->plan.first_layer_height, shell->core[1]);
+  // One layer a boundary: the core's, then every t up to the slab's top.
+  const std::string& prof = part->layer_heights_profile;
+  EXPECT_EQ(prof.rfind("object_id=1|", 0), 0u);
+  const auto layers = static_cast<std::size_t>(std::count(prof.begin(), prof.end(), ';')) / 4;
+  EXPECT_EQ(layers, shell->core.size() - 1 + static_cast<std::size_t>(shell->N) + 1);
+  // The anchor: the rib's outline at its second layer.
+  EXPECT_EQ(part->plan.anchor_z, shell->core[2]);
+  ASSERT_GE(part->plan.anchor.size(), 4u);
+  auto back = parse_plan_json(plan_json(part->plan));
+  ASSERT_TRUE(back) << back.error().message;
+  EXPECT_EQ(back->anchor, part->plan.anchor);
+  auto moved = layers::parse_shell_plan_json(back->shell, {3, -4});
+  ASSERT_TRUE(moved) << moved.error().message;
+  EXPECT_EQ(moved->core, shell->core);
+  EXPECT_EQ(moved->top.h, shell->top.h);
+  EXPECT_EQ(moved->top.origin, shell->top.origin + Vec2(3, -4));
+  EXPECT_EQ(moved->reach, shell->reach);
+  // What a plan may not say of a shell.
+  auto bad = [&](const std::string& from, const std::string& to) {
+    std::string f = part->plan.shell;
+    const auto at = f.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    f.replace(at, from.size(), to);
+    auto r = layers::parse_shell_plan_json(f);
+    return r ? std::string() : r.error().message;
+  };
+  EXPECT_NE(bad("\"t\":", "\"t\":-").find("t must lie"), std::string::npos);
+  EXPECT_NE(bad("\"N\":", "\"N\":0,\"x\":").find("N must be"), std::string::npos);
+  EXPECT_NE(bad("\"count\":", "\"count\":1,\"x\":").find("must hold"), std::string::npos);
+  EXPECT_NE(bad("\"nx\":", "\"nx\":1,\"x\":").find("must hold"), std::string::npos);
 }
 
 TEST(PrintPlan, NothingCurvedIsNothingToPrepare) {
