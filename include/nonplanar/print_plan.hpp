@@ -48,10 +48,11 @@ struct PreparedPart {
   /// shell's normalised slab above it (from the top of the core's layers up).
   TriangleMesh normalized;
   PrintPlan plan;
-  std::shared_ptr<const LayerField> field;  ///< the plan's field (plan.field as read back)
-  std::vector<Notice> notices;              ///< as slice_model's (patches printed planar and why)
-  std::size_t stacks = 0;                   ///< curved stacks in the plan
-  int shell_layers = 0;                     ///< a shell's curved layers (0: no shell)
+  /// The plan's stacks' field (plan.field as read back); null for a shell (plan.shell).
+  std::shared_ptr<const LayerField> field;
+  std::vector<Notice> notices;  ///< as slice_model's (patches printed planar and why)
+  std::size_t stacks = 0;       ///< curved stacks in the plan
+  int shell_layers = 0;         ///< a shell's curved layers (0: no shell)
   /// PrusaSlicer's layer-height profile for the part (Slic3r_PE_layer_heights_profile.txt;
   /// empty: none, the layers are the plan's layer_height).
   std::string layer_heights_profile;
