@@ -224,6 +224,33 @@ TEST(PostProcess, WhatThePlanNeedsIsRefusedByName) {
   EXPECT_NE(refused(planar_gcode(d.part.normalized)).find("no settings block"), std::string::npos);
 }
 
+// A shell's plan maps only a file on its layers: the core's boundaries, then the shell's; a file
+// in even layers, or one whose layers stop short (its settings block kept), is refused by name.
+TEST(PostProcess, AShellsPlanRefusesAFileOffItsLayers) {
+  const TriangleMesh rib = test::placed(test::rib(), PrintConfig{});
+  auto part = prepare_part(rib, make_job(PrintConfig{}), {});
+  ASSERT_TRUE(part) << part.error().message;
+  ASSERT_GT(part->shell_layers, 0);
+  PrintConfig c;
+  c.slice.first_layer_height = part->plan.first_layer_height;
+  const std::string even = sliced(part->normalized, "", c);
+  auto r = post_process_gcode(even, part->plan, {});
+  ASSERT_FALSE(r);
+  EXPECT_NE(r.error().message.find("where the plan's shell begins: keep the object's "
+                                   "layer-height profile"),
+            std::string::npos)
+      << r.error().message;
+  const std::size_t block = even.find("; prusaslicer_config = begin");
+  ASSERT_NE(block, std::string::npos);
+  for (const double share : {0.1, 0.5, 0.97}) {
+    const std::size_t at =
+        even.rfind("\n;LAYER_CHANGE", static_cast<std::size_t>(share * static_cast<double>(block)));
+    ASSERT_NE(at, std::string::npos);
+    auto cut = post_process_gcode(even.substr(0, at + 1) + even.substr(block), part->plan, {});
+    EXPECT_FALSE(cut) << share;
+  }
+}
+
 // The names object labels give, in the three ways slicers write them.
 TEST(PostProcess, ObjectLabelsNameTheParts) {
   EXPECT_EQ(gcode_object_names("; printing object dome id:0 copy 0\nG1 X1\n; stop printing object "
