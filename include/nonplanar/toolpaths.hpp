@@ -16,11 +16,13 @@ enum class ExtrusionRole {
   solid_infill,
   top_solid_infill,
   skirt,
+  support,  ///< another slicer's supports (the built-in engine prints none)
 };
 /// PrusaSlicer's ;TYPE: names ("External perimeter", "Internal infill", "Skirt/Brim", ...).
 const char* role_name(ExtrusionRole r);
 /// The role of a ;TYPE: name, PrusaSlicer's and OrcaSlicer's ("Overhang perimeter" is an
-/// external one, "Ironing" a top skin's, "Brim" a skirt's); anything else is solid infill.
+/// external one, "Ironing" a top skin's, "Brim" a skirt's, "Support material interface" and
+/// OrcaSlicer's "Support transition" supports); anything else is solid infill.
 ExtrusionRole role_from_name(std::string_view type);
 
 /// One extrusion: a polyline (closed loops repeat their first point at the end). points[i]

@@ -108,9 +108,11 @@ std::vector<std::string> engine_forced_settings(const EngineParams& e, const Pri
   return s;
 }
 
-// What the shell's slab run forces: no skirt or brim, its first layer like the others.
+// What the shell's slab run forces: no skirt, brim or supports (the slab rests on the core),
+// its first layer like the others.
 const std::pair<const char*, const char*> kSlab[] = {{"skirts", "0"},
                                                      {"brim_width", "0"},
+                                                     {"support_material", "0"},
                                                      {"first_layer_speed", "100%"},
                                                      {"first_layer_extrusion_width", "0"},
                                                      {"elefant_foot_compensation", "0"},

@@ -126,16 +126,19 @@ Expected<ForeignGcode> map_shell_core(std::string_view core_text, const layers::
     return e;
   }
   // An engine that ignored the profile would leave the stairs other than planned, and the
-  // shell's lowest layer thicker or thinner than the gate believes: refuse such a core.
+  // shell's lowest layer thicker or thinner than the gate believes: refuse such a core. A
+  // layer of supports alone (PrusaSlicer prints them on layers of their own, a contact
+  // distance under the part) holds no stair.
   for (const LayerToolpaths& L : core->layers) {
-    if (L.paths.empty()) continue;
+    const bool part = std::any_of(L.paths.begin(), L.paths.end(), [](const ExtrusionPath& p) {
+      return p.role != ExtrusionRole::support && p.role != ExtrusionRole::skirt;
+    });
     const auto near = std::lower_bound(plan.core.begin(), plan.core.end(), L.max_z - 2e-3);
-    if (near == plan.core.end() || *near > L.max_z + 2e-3) {
+    if (part && (near == plan.core.end() || *near > L.max_z + 2e-3)) {
       char buf[300];
       std::snprintf(buf, sizeof buf,
                     "the core has a layer at z = %.3f mm, not on the planned boundaries: the "
-                    "slicer did not follow the 3MF's layer-height profile, or printed supports "
-                    "on layers of their own (a shell's part cannot have supports yet)",
+                    "slicer did not follow the 3MF's layer-height profile",
                     L.max_z);
       return Error{Status::unsupported, buf};
     }

@@ -47,13 +47,22 @@ Expected<void> write_program(SliceResult& r, const SliceJob& job, const Context&
 
 namespace {
 
+// Whether a path is another slicer's support on a plane: printed as that slicer made it, on
+// layers of its own a contact distance apart (PrusaSlicer's beside a shell's core: 0.02 mm).
+bool flat_support(const ExtrusionPath& p) {
+  return p.role == ExtrusionRole::support &&
+         std::all_of(p.points.begin(), p.points.end(),
+                     [&](const Vec3& q) { return q.z() == p.points.front().z(); });
+}
+
 // Thickness within [h_min, h_max] on the paths' heights, with g's slack: the ones each
-// point's extrusion was computed from (the file holds none).
+// point's extrusion was computed from (the file holds none). Not the skirt, nor supports on a
+// plane (a support under a curved band is judged).
 bool heights(const SliceResult& r, const LayerParams& L, const GateParams& g,
              const Violation& violation) {
   for (std::size_t li = 1; li < r.layers.size(); ++li)
     for (const ExtrusionPath& p : r.layers[li].paths) {
-      if (p.role == ExtrusionRole::skirt) continue;
+      if (p.role == ExtrusionRole::skirt || flat_support(p)) continue;
       for (std::size_t k = 0; k < p.points.size(); ++k)
         if ((p.height[k] < L.min_layer_height - g.thickness_slack ||
              p.height[k] > L.max_layer_height + g.thickness_slack) &&

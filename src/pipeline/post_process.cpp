@@ -339,6 +339,13 @@ Expected<ShellSplit> shell_split(const GcodeProgram& prog, std::string_view gcod
     if (!m.extruding() && m.has_e) out.retracted -= m.de;
   }
   if (out.first_move == 0) return refuse("the shell's layers hold no move");
+  // Supports the slicer put under the slab (it stands above the part in the 3MF) would be laid
+  // on the part with the shell; there is nothing under the shell to support.
+  for (const GcodeMove& m : prog.moves)
+    if (m.layer > static_cast<int>(k) && m.extruding() &&
+        role_from_name(m.type) == ExtrusionRole::support)
+      return refuse("supports in the shell's layers (line " + std::to_string(m.line) +
+                    "): with a shell, switch supports off or to build plate only");
   return out;
 }
 

@@ -21,6 +21,8 @@ const char* role_name(ExtrusionRole r) {
       return "Top solid infill";
     case ExtrusionRole::skirt:
       return "Skirt/Brim";
+    case ExtrusionRole::support:
+      return "Support material";
   }
   return "Custom";
 }
@@ -32,6 +34,9 @@ ExtrusionRole role_from_name(std::string_view type) {
   if (type == "Internal infill") return ExtrusionRole::internal_infill;
   if (type == "Top solid infill" || type == "Ironing") return ExtrusionRole::top_solid_infill;
   if (type == "Skirt/Brim" || type == "Skirt" || type == "Brim") return ExtrusionRole::skirt;
+  if (type.find("Support") != std::string_view::npos ||
+      type.find("support") != std::string_view::npos)
+    return ExtrusionRole::support;
   return ExtrusionRole::solid_infill;
 }
 

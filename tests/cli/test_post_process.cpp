@@ -343,6 +343,28 @@ TEST(PostProcessRoute, AShellRefusesLayersOffItsProfile) {
   EXPECT_EQ(test::read_bytes(out), before);
 }
 
+// Supports PrusaSlicer puts under the slab (which stands above the part in the 3MF) would be
+// laid on the part with the shell: refused, naming the setting; build plate only prints.
+TEST(PostProcessRoute, AShellRefusesSupportsUnderItsSlab) {
+  if (!have_prusaslicer()) GTEST_SKIP() << "prusa-slicer not installed";
+  const fs::path dir = test::temp_dir("pp_shell_supports");
+  ASSERT_TRUE(write_stl(dir / "rib.stl", test::rib()));
+  const fs::path plan = dir / "rib.3mf", out = dir / "rib.gcode";
+  const auto p = test::run_cli("prepare " + (dir / "rib.stl").string() + " -o " + plan.string());
+  ASSERT_EQ(p.code, 0) << p.err;
+  const std::string slice = "--export-gcode --first-layer-height " + first_layer(p.err) +
+                            " --support-material -o " + out.string() + " ";
+  ASSERT_EQ(prusa(slice + plan.string()), 0);
+  const std::string before = test::read_bytes(out);
+  const auto r = test::run_cli("post-process --plan " + plan.string() + " " + out.string());
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("supports in the shell's layers"), std::string::npos) << r.err;
+  EXPECT_EQ(test::read_bytes(out), before);
+  ASSERT_EQ(prusa(slice + "--support-material-buildplate-only " + plan.string()), 0);
+  const auto ok = test::run_cli("post-process --plan " + plan.string() + " " + out.string());
+  EXPECT_EQ(ok.code, 0) << ok.err;
+}
+
 TEST(PrepareCli, APartWithNothingToPlanIsRefused) {
   const fs::path dir = test::temp_dir("prepare_refuse");
   // Its shell would print beside the tower standing above it: one slicer run cannot.

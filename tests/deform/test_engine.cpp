@@ -127,6 +127,30 @@ TEST(EnginePrusaSlicer, WingPrintsAsAShellOverItsCore) {
   EXPECT_NE(r->gcode.find("; use_relative_e_distances = 1"), std::string::npos);
 }
 
+// Supports on: PrusaSlicer prints them on layers of their own between the core's boundaries,
+// some 0.02 mm apart; they hold no stair and are printed as it made them. The shell still
+// prints (it was refused, the part planar), with the supports under its roof, 0 collisions.
+TEST(EnginePrusaSlicer, AShellPrintsWithSupportsOn) {
+  if (!have_prusaslicer()) GTEST_SKIP() << "prusa-slicer not installed";
+  PrintConfig c;
+  const TriangleMesh mesh = test::placed(test::hollow_roof(1.5), c);
+  SliceJob job = make_job(c);
+  job.engine.engine = Engine::prusaslicer;
+  job.engine.overrides = {{"support_material", "1"}};
+  auto r = slice_model(mesh, job, {});
+  ASSERT_TRUE(r) << r.error().message;
+  EXPECT_EQ(r->shell_layers, 4);
+  EXPECT_EQ(r->collisions, 0u);
+  EXPECT_NE(r->gcode.find(";TYPE:Support material"), std::string::npos);
+  EXPECT_NE(r->gcode.find("support_material = 0"), std::string::npos);  // the slab's run
+  auto moves = read_gcode_moves(r->gcode);
+  ASSERT_TRUE(moves) << moves.error().message;
+  auto f = check_print(*moves, &mesh, {}, {});
+  ASSERT_TRUE(f);
+  EXPECT_EQ(f->collisions, 0u);
+  EXPECT_GT(f->steepest_deg, 10);  // curved
+}
+
 // An engine that does not slice on the planned boundaries (here: one that forces its own first
 // layer) must not get its core under the shell: the part is sliced planar, with a notice.
 TEST(EnginePrusaSlicer, ACoreOffThePlannedBoundariesFallsBackToPlanar) {
