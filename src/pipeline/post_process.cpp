@@ -91,9 +91,8 @@ bool outline(std::string_view type) {
          type == "Overhang wall";
 }
 bool not_the_part(std::string_view type) {
-  return type == "Skirt/Brim" || type == "Skirt" || type == "Brim" ||
-         type.find("Support") != std::string_view::npos ||
-         type.find("support") != std::string_view::npos;
+  const ExtrusionRole r = role_from_name(type);
+  return r == ExtrusionRole::skirt || r == ExtrusionRole::support;
 }
 
 // The settings the plan needs kept, checked against the file: the layers as sliced (a
@@ -274,6 +273,7 @@ Expected<std::vector<char>> moves_of_part(const GcodeProgram& prog, const PrintP
 // with tops on the plan's boundaries up to z_s; the layer z_s … z_s + t that held the shell's
 // slab up (cut away); the shell's layers, t thick. Byte offsets into the file.
 struct ShellSplit {
+  layers::ShellPlan plan;  ///< the plan's shell, where prepare placed the part
   std::size_t print_begin = 0, plate = 0, shell = 0, print_end = 0;
   std::size_t first_move = 0;  ///< the shell's first layer's first move (its header before it)
   double e = 0;                ///< the file's E where the shell's first layer begins
@@ -284,9 +284,11 @@ struct ShellSplit {
 
 Expected<ShellSplit> shell_split(const GcodeProgram& prog, std::string_view gcode,
                                  const PrintPlan& plan) {
+  ShellSplit out;
   auto shell = layers::parse_shell_plan_json(plan.shell);
   if (!shell) return shell.error();
-  const double z_s = shell->core.back(), t = shell->t;
+  out.plan = std::move(*shell);
+  const double z_s = out.plan.core.back(), t = out.plan.t;
   const auto& z = prog.layer_z;
   std::size_t k = 0;
   while (k < z.size() && z[k] <= z_s + 2e-3) ++k;
@@ -308,7 +310,6 @@ Expected<ShellSplit> shell_split(const GcodeProgram& prog, std::string_view gcod
       return refuse(buf);
     }
   }
-  ShellSplit out;
   const auto at = [&](std::size_t line) {
     return line < prog.lines.size()
                ? static_cast<std::size_t>(prog.lines[line].raw.data() - gcode.data())
@@ -396,11 +397,10 @@ Expected<Checked> checked_placement(std::string_view gcode, const std::string& b
 // file without the shell's and the layer under them) cut back under the shell; the shell's
 // layers (after the file's start G-code, the E, fan and retraction the file had when they
 // began) mapped onto the shell; joined.
-Expected<EngineShell> map_shell_gcode(std::string_view gcode, const ShellSplit& sp,
-                                      const PrintPlan& plan, const Vec2& moved, const SliceJob& job,
-                                      const Context& ctx) {
-  auto shell = layers::parse_shell_plan_json(plan.shell, moved);
-  if (!shell) return shell.error();
+Expected<EngineShell> map_shell_gcode(std::string_view gcode, ShellSplit& sp, const Vec2& moved,
+                                      const SliceJob& job, const Context& ctx) {
+  const layers::ShellPlan& shell = sp.plan;
+  sp.plan.top.origin += moved;  // H follows the part on the plate
   std::string core_text;
   core_text.reserve(sp.plate + gcode.size() - sp.print_end);
   core_text.append(gcode.substr(0, sp.plate)).append(gcode.substr(sp.print_end));
@@ -418,9 +418,9 @@ Expected<EngineShell> map_shell_gcode(std::string_view gcode, const ShellSplit& 
   }
   shell_text.append(gcode.substr(sp.first_move));
   const EngineRoute route{job.engine, job.print, job.layers, job.map_back};
-  auto core = map_shell_core(core_text, *shell, route, ctx);
+  auto core = map_shell_core(core_text, shell, route, ctx);
   if (!core) return core.error();
-  return join_shell(std::move(*core), shell_text, *shell, shell->core.back() + shell->t, route,
+  return join_shell(std::move(*core), shell_text, shell, shell.core.back() + shell.t, route,
                     "the shell's curved layers, from the slicer's layers above the core", ctx);
 }
 
@@ -476,7 +476,7 @@ Expected<PostProcessed> post_process_gcode(std::string_view gcode, const PrintPl
   SliceResult r;
   std::string body;
   if (checked->split) {
-    auto joined = map_shell_gcode(gcode, *checked->split, plan, moved, job, ctx);
+    auto joined = map_shell_gcode(gcode, *checked->split, moved, job, ctx);
     if (!joined) return joined.error();
     r.layers = std::move(joined->layers);
     body = std::move(joined->gcode);
