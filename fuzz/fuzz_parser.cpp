@@ -18,6 +18,11 @@
 
 #if NONPLANAR_FUZZ_PARSER == 8
 #include <cmath>
+#include <string>
+#include <vector>
+
+#include "nonplanar/program.hpp"
+#include "program/splice_lines.hpp"
 namespace {
 // Layers 0.2 mm thick at x = 0, thicker and thinner along x (every column curved), so the
 // mapper resamples, scales and lifts as it does over a stack.
@@ -140,6 +145,18 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   o.start = Vec3(100, 100, 3);
   o.start_retracted = 0.8;
   (void)map_foreign_gcode(in, field, {}, {}, o);
+  // Some of its lines spliced as the shell route splits a plate (program/splice_lines.hpp),
+  // a third of them another object's, then mapped as its core.
+  const GcodeProgram prog = read_gcode_program(in);
+  std::vector<char> keep(prog.lines.size());
+  for (std::size_t i = 0; i < keep.size(); ++i) keep[i] = static_cast<char>(i % 3);
+  std::string spliced;
+  std::vector<char> marks;
+  program::LineSplicer splice(prog);
+  splice.append(0, prog.lines.size(), keep, spliced, &marks);
+  o.planar_lines.assign(marks.size(), 0);
+  for (std::size_t i = 0; i < marks.size(); ++i) o.planar_lines[i] = marks[i] == 2;
+  (void)map_foreign_gcode(spliced, field, {}, {}, o);
 #elif NONPLANAR_FUZZ_PARSER == 9
   // A head file that parses must also answer the collision search's queries.
   const auto shape = parse_toolhead_shape(in);

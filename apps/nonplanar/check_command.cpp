@@ -9,6 +9,7 @@
 #include "core/file_bytes.hpp"
 #include "nonplanar/check.hpp"
 #include "nonplanar/gcode.hpp"
+#include "nonplanar/print_plan.hpp"
 
 namespace nonplanar::cli {
 namespace {
@@ -45,6 +46,13 @@ int run(const CheckOptions& o) {
            report_error({moves.error().status, o.gcode + ": " + moves.error().message});
   LoadParams lp = o.mesh.load;
   lp.bed_center = cfg->bed_center();
+  // A file post-process mapped says where the slicer put the part (moved, on a plate).
+  if (const auto centre = post_processed_centre(bytes->view())) {
+    if (!(o.mesh.quiet || o.json) && (*centre - lp.bed_center).norm() > 1e-3)
+      std::fprintf(stderr, "the mesh centred at %.3f, %.3f mm, where the file's header puts it\n",
+                   centre->x(), centre->y());
+    lp.bed_center = *centre;
+  }
   auto mesh = load_mesh(o.mesh.model, lp, ctx);
   if (!mesh) return finish_progress(), report_error(mesh.error());
   auto f = check_print(*moves, &mesh->mesh, params, ctx);
@@ -135,7 +143,8 @@ void register_check(CLI::App& app, std::function<int()>* run_fn) {
   CLI::App* cmd = app.add_subcommand(
       "check",
       "Recompute the quality figures of a G-code file against its mesh (placed as PrusaSlicer\n"
-      "places it: XY centre at the bed centre, lowest point at z = 0): top-surface deviation,\n"
+      "places it: XY centre at the bed centre, lowest point at z = 0; in a file post-process\n"
+      "wrote, where its header says the slicer put it): top-surface deviation,\n"
       "layer thickness, steepest extrusion, collisions, volume ratio, extrusion outside the\n"
       "mesh. Works on PrusaSlicer's G-code too, and reads the bed and printer from its\n"
       "settings block (the profile options go over it). See docs/check.md for each figure.");

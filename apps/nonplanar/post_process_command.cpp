@@ -108,6 +108,8 @@ int run(const PostProcessOptions& o) {
     return report_error(e);
   }
   if (auto w = write_gcode_text(out, mapped->gcode, ctx); !w) return report_error(w.error());
+  for (const std::string& n : mapped->notices)
+    if (!o.quiet) std::fprintf(stderr, "notice: %s\n", n.c_str());
   if (!o.quiet)
     std::fprintf(stderr,
                  "mapped %s onto the curved layers of %s: %zu layers, layer thickness "

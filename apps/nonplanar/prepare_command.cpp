@@ -95,8 +95,9 @@ void print_instructions(const std::string& out, const PreparedPart& part) {
   if (part.shell_layers > 0)
     std::fprintf(stderr,
                  "  - the object's variable layer height as prepared (do not edit or reset it) "
-                 "and first layer height %s mm; arc fitting off; the object alone on the "
-                 "plate; no scaling or rotating (moving is fine);\n",
+                 "and first layer height %s mm; arc fitting off; no scaling or rotating "
+                 "(moving is fine); other objects on the plate only with Label objects on, "
+                 "and none taller than the shell near it (the shell prints after them);\n",
                  num(p.first_layer_height).c_str());
   else
     std::fprintf(stderr,

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -74,6 +75,8 @@ struct PostProcessed {
   std::size_t layers = 0;  ///< layers of the print
   double thickness_min = 0, thickness_max = 0, steepest_deg = 0;
   PrintStats stats;
+  /// What it changed beyond the mapping, one line each (supports it left out).
+  std::vector<std::string> notices;
 };
 
 /// Maps a slicer's G-code of the prepared part back onto the curved layers (the same passes
@@ -82,7 +85,7 @@ struct PostProcessed {
 /// head from the plan. Refused (invalid_argument, naming the setting or what to change): a
 /// file already post-processed, no settings block, another layer height or first layer
 /// height, arc fitting, spiral vase, variable layer height, a part scaled or rotated (its
-/// extrusions' box against the plan's), more than the planned part on the plate; a
+/// extrusions' box against the plan's), other objects without labels to tell them apart; a
 /// violation of the limits (internal_error names where).
 Expected<PostProcessed> post_process_gcode(std::string_view gcode, const PrintPlan& plan,
                                            const Context& ctx);
@@ -94,5 +97,10 @@ std::vector<std::string> gcode_object_names(std::string_view gcode);
 
 /// The first line post_process_gcode writes (how a file already post-processed is known).
 inline constexpr std::string_view kPostProcessedMark = "; post-processed by nonplanar";
+
+/// Where the planned part's box is centred on the plate (mm, XY) in a file post_process_gcode
+/// wrote, as its header says (kPartCentredAt); none for another file.
+std::optional<Vec2> post_processed_centre(std::string_view gcode);
+inline constexpr std::string_view kPartCentredAt = "; the part's box centred at ";
 
 }  // namespace nonplanar

@@ -33,7 +33,9 @@ struct ExtrusionPath {
   double speed = 40;  ///< mm/s
   std::vector<Vec3> points;
   std::vector<double> height;
-  int object = 0;  ///< the plate object it prints (PlateObjects' index; 0 for one object)
+  /// The plate object it prints (PlateObjects' index; 0 for one object). In another slicer's
+  /// file mapped back: 0 the planned part's, 1 another object's, kept as written.
+  int object = 0;
 };
 
 struct LayerToolpaths {

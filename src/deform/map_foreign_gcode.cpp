@@ -53,9 +53,9 @@ void add_pieces(const GcodeMove& m, const ExtrusionPath& p, LayerToolpaths& L, l
     s.layer.move_from(s.at, s.at, s.pending, kNoValue), s.pending = 0;
   }
   if (!m.extruding() && m.has_e) s.retracted -= m.de;
-  if (m.extruding() && run < 0) {
+  if (m.extruding() && (run < 0 || L.paths[static_cast<std::size_t>(run)].object != p.object)) {
     ExtrusionPath g;
-    g.role = role_from_name(m.type), g.width = m.width;
+    g.role = role_from_name(m.type), g.width = m.width, g.object = p.object;
     g.points.push_back(p.points[0]);
     g.height.push_back(p.height[0]);
     L.paths.push_back(std::move(g));
@@ -189,7 +189,14 @@ std::optional<Error> write_layer(InOrder& o, const GcodeLayerSpan& span,
   LayerWork work{seq, o.prog.moves, o.mapped};
   LayerToolpaths& L = o.out.layers[span.layer];
   const double z = o.prog.layer_z[span.layer];
-  const auto cover = o.options.clip ? o.options.clip->cover(z) : LayerClip::Cover::all;
+  auto cover = o.options.clip ? o.options.clip->cover(z) : LayerClip::Cover::all;
+  // Another object's moves in the layer stay whatever the clip would do to the planned part's.
+  auto untouched = [&](const GcodeMove& m) { return kept_planar(o.options.planar_lines, m); };
+  if (cover == LayerClip::Cover::none && !o.options.planar_lines.empty() &&
+      std::any_of(seq.begin(), seq.end(), [&](const GcodeLine& l) {
+        return l.kind == Kind::move && untouched(o.prog.moves[static_cast<std::size_t>(l.move)]);
+      }))
+    cover = LayerClip::Cover::some;
   o.s.layer.clear();
   if (cover == LayerClip::Cover::none) {
     program::dropped_layer(seq, o.s.layer);
@@ -203,7 +210,7 @@ std::optional<Error> write_layer(InOrder& o, const GcodeLayerSpan& span,
       return o.options.clip->slope_bound(lo, hi, z);
     };
     if (const int bad = program::clip_layer(work, margin, bound, o.prog.retraction, o.params.passes,
-                                            o.clip_samples))
+                                            o.clip_samples, untouched))
       return Error{Status::invalid_argument, "line " + std::to_string(bad) + ": more than " +
                                                  std::to_string(o.params.passes.most_clip_samples) +
                                                  " clip samples"};

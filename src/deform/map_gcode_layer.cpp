@@ -28,6 +28,7 @@ std::optional<Error> map_gcode_layer(std::span<const GcodeLine> lines,
     if (kept_planar(planar_lines, m)) {
       p.points = {m.from, m.to};
       p.height = {m.height, m.height};
+      p.object = 1;  // another object's (ExtrusionPath::object)
       add_to_reach(p, L);
       continue;
     }

@@ -114,10 +114,12 @@ Expected<ForeignGcode> core_with_engine(const TriangleMesh& mesh, const layers::
 }  // namespace
 
 Expected<ForeignGcode> map_shell_core(std::string_view core_text, const layers::ShellPlan& plan,
-                                      const EngineRoute& job, const Context& ctx) {
+                                      const EngineRoute& job, const Context& ctx,
+                                      std::vector<char> others) {
   const CoreClip clip(plan, 0.5 * job.print.paths.perimeter_width);
   ForeignMapOptions core_opt;
   core_opt.clip = &clip;
+  core_opt.planar_lines = std::move(others);
   const auto planar = planar_field(job.layers);
   auto core = map_foreign_gcode(core_text, *planar, job.map_back, ctx, core_opt);
   if (!core) {
@@ -131,7 +133,7 @@ Expected<ForeignGcode> map_shell_core(std::string_view core_text, const layers::
   // distance under the part) holds no stair.
   for (const LayerToolpaths& L : core->layers) {
     const bool part = std::any_of(L.paths.begin(), L.paths.end(), [](const ExtrusionPath& p) {
-      return p.role != ExtrusionRole::support && p.role != ExtrusionRole::skirt;
+      return p.role != ExtrusionRole::support && p.role != ExtrusionRole::skirt && p.object == 0;
     });
     const auto near = std::lower_bound(plan.core.begin(), plan.core.end(), L.max_z - 2e-3);
     if (part && (near == plan.core.end() || *near > L.max_z + 2e-3)) {
@@ -180,12 +182,25 @@ Expected<EngineShell> shell_with_engine(const TriangleMesh& mesh, const layers::
 
 Expected<EngineShell> join_shell(ForeignGcode core, std::string_view shell_text,
                                  const layers::ShellPlan& plan, double base, const EngineRoute& job,
-                                 const std::string& note, const Context& ctx) {
-  // Entered from where the core ended.
+                                 const std::string& note, const Context& ctx,
+                                 const std::optional<Vec2>& enter_over) {
+  // Entered from where the core ended, or from over everything printed.
   const layers::ShellPathField path_field(plan, base);
   ctx.progress("map back", 0);
   ForeignMapOptions shell_opt;
   shell_opt.start = core.end_at;
+  std::string entry;
+  if (enter_over) {
+    double top = core.end_at.z();
+    for (const LayerToolpaths& L : core.layers) top = std::max(top, L.max_z);
+    top += job.map_back.travel_lift;
+    char buf[160];
+    std::snprintf(buf, sizeof buf, "G1 Z%.3f F%.0f\nG1 X%.3f Y%.3f F%.0f\n", top,
+                  60 * std::min(job.print.paths.travel_speed, 20.0), enter_over->x(),
+                  enter_over->y(), 60 * job.print.paths.travel_speed);
+    entry = buf;
+    shell_opt.start = Vec3(enter_over->x(), enter_over->y(), top);
+  }
   shell_opt.start_retracted = core.retracted;
   auto shell = map_foreign_gcode(shell_text, path_field, job.map_back, ctx, shell_opt);
   if (!shell) {
@@ -200,6 +215,7 @@ Expected<EngineShell> join_shell(ForeignGcode core, std::string_view shell_text,
                     256);
   out.gcode.append(core.start).append(core.print);
   out.gcode += "; nonplanar: " + note + "\n";
+  out.gcode += entry;
   out.gcode += shell->relative_e_at_print ? "M83\n" : "M82\n";
   if (!shell->fan_at_print.empty()) out.gcode += shell->fan_at_print + "\n";
   char buf[64];

@@ -2,6 +2,7 @@
 // (PrusaSlicer): two runs of it, stitched into one program.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -32,17 +33,24 @@ Expected<EngineShell> shell_with_engine(const TriangleMesh& mesh, const layers::
                                         const EngineRoute& job, const Context& ctx);
 
 /// The core's G-code (a planar program sliced on plan.core's boundaries) mapped and cut back
-/// under the shell, as shell_with_engine maps its first run. Errors: those of the mapping, and
-/// unsupported for a layer off the planned boundaries (the profile was not followed).
+/// under the shell, as shell_with_engine maps its first run; the moves of `others` (0-based
+/// lines of core_text; empty: none) are other objects', left as written and neither cut nor
+/// held to the boundaries. Errors: those of the mapping, and unsupported for a layer of the
+/// part off the planned boundaries (the profile was not followed).
 Expected<ForeignGcode> map_shell_core(std::string_view core_text, const layers::ShellPlan& plan,
-                                      const EngineRoute& job, const Context& ctx);
+                                      const EngineRoute& job, const Context& ctx,
+                                      std::vector<char> others = {});
 
 /// Inputs: the mapped core, the shell's G-code (its layers planes of ShellField(plan, base)),
-/// the note written where the shell begins. Output: one program: the core's start and layers,
-/// the shell's layers mapped onto the shell (entered from where the core ended, its retraction
-/// given back; its fan as the shell's program had it when its print began), the core's end.
+/// the note written where the shell begins, and optionally where to enter the shell from
+/// above (XY, mm: other objects printed with the core may stand higher than the shell where
+/// the core ended; the nozzle then rises to the highest point printed + travel_lift and goes
+/// there first). Output: one program: the core's start and layers, the shell's layers mapped
+/// onto the shell (entered from where the core ended, its retraction given back; its fan as
+/// the shell's program had it when its print began), the core's end.
 Expected<EngineShell> join_shell(ForeignGcode core, std::string_view shell_text,
                                  const layers::ShellPlan& plan, double base, const EngineRoute& job,
-                                 const std::string& note, const Context& ctx);
+                                 const std::string& note, const Context& ctx,
+                                 const std::optional<Vec2>& enter_over = std::nullopt);
 
 }  // namespace nonplanar

@@ -15,6 +15,7 @@
 #include "nonplanar/print_plan.hpp"
 #include "nonplanar/program.hpp"
 #include "pipeline/gate.hpp"
+#include "pipeline/shell_split.hpp"
 
 namespace nonplanar {
 
@@ -239,115 +240,48 @@ Expected<Vec2> placement(const GcodeProgram& prog, const std::vector<char>& ours
   return Vec2(0.5 * (b.min + b.max).head<2>() - 0.5 * (plan.box.min + plan.box.max).head<2>());
 }
 
-// Which moves are the planned part's: with object labels naming several objects, all but those
-// between another object's start and end labels; else all of them. Refused when the labels
-// name several objects and none is the plan's.
-Expected<std::vector<char>> moves_of_part(const GcodeProgram& prog, const PrintPlan& plan) {
-  std::vector<char> ours(prog.moves.size(), 1);
+// Whose each line is (LineOwner): with object labels naming several objects, a line between
+// another object's start and end labels is that object's (the labels too); else every line is
+// the part's or outside labels. Refused when the labels name several objects and none is the
+// plan's.
+Expected<std::vector<char>> line_owners(const GcodeProgram& prog, const PrintPlan& plan) {
+  std::vector<char> owner(prog.lines.size(), kUnlabelled);
   std::vector<std::string> names;
   std::string current, name;
   LabelReader labels;
-  for (const GcodeLine& l : prog.lines) {
+  for (std::size_t i = 0; i < prog.lines.size(); ++i) {
+    const GcodeLine& l = prog.lines[i];
     const Label k = l.kind == GcodeLine::Kind::text ? labels.read(l.raw, &name) : Label::none;
     if (k == Label::start) {
       current = name;
       if (std::find(names.begin(), names.end(), name) == names.end()) names.push_back(name);
     }
+    if (!current.empty()) owner[i] = current == plan.object ? kOurs : kOthers;
     if (k == Label::end) current.clear();
-    // Moves outside every label (travels between objects, layer changes) are the field's.
-    if (l.kind == GcodeLine::Kind::move && l.move >= 0)
-      ours[l.move] = current.empty() || current == plan.object;
   }
   // One object on the plate is the planned one, whatever the user renamed it to.
-  if (names.size() <= 1) return std::vector<char>(prog.moves.size(), 1);
+  if (names.size() <= 1) {
+    for (char& o : owner)
+      if (o == kOthers) o = kOurs;
+    return owner;
+  }
   if (std::find(names.begin(), names.end(), plan.object) == names.end()) {
     std::string list;
     for (const std::string& n : names) list += (list.empty() ? "" : ", ") + n;
     return refuse("the plate's objects are " + list + "; none is " + plan.object +
                   ", the plan's (keep the name prepare gave it)");
   }
-  return ours;
+  return owner;
 }
 
-// Where a shell plan's G-code splits (prepare_shell in prepare_part.cpp): the core's layers,
-// with tops on the plan's boundaries up to z_s; the layer z_s … z_s + t that held the shell's
-// slab up (cut away); the shell's layers, t thick. Byte offsets into the file.
-struct ShellSplit {
-  layers::ShellPlan plan;  ///< the plan's shell, where prepare placed the part
-  std::size_t print_begin = 0, plate = 0, shell = 0, print_end = 0;
-  std::size_t first_move = 0;  ///< the shell's first layer's first move (its header before it)
-  double e = 0;                ///< the file's E where the shell's first layer begins
-  double retracted = 0;        ///< filament the print's own moves have pulled back there, mm
-  bool relative_e = false;
-  std::string fan;  ///< the last M106/M107 before it ("" when none)
-};
-
-Expected<ShellSplit> shell_split(const GcodeProgram& prog, std::string_view gcode,
-                                 const PrintPlan& plan) {
-  ShellSplit out;
-  auto shell = layers::parse_shell_plan_json(plan.shell);
-  if (!shell) return shell.error();
-  out.plan = std::move(*shell);
-  const double z_s = out.plan.core.back(), t = out.plan.t;
-  const auto& z = prog.layer_z;
-  std::size_t k = 0;
-  while (k < z.size() && z[k] <= z_s + 2e-3) ++k;
-  char buf[320];
-  if (k + 1 >= z.size() || std::abs(z[k] - (z_s + t)) > 2e-3) {
-    std::snprintf(buf, sizeof buf,
-                  "no layer ends at z = %.3f mm, where the plan's shell begins: keep the object's "
-                  "layer-height profile as prepared (variable layer height untouched)",
-                  z_s + t);
-    return refuse(buf);
-  }
-  for (std::size_t q = k + 1; q + 1 < z.size(); ++q) {
-    const double j = (z[q] - z_s) / t;
-    if (std::abs(j - std::round(j)) > 0.01) {
-      std::snprintf(buf, sizeof buf,
-                    "layer %zu ends at z = %.3f mm, not on the plan's shell layers (%.3f mm "
-                    "thick from %.3f): keep the object's layer-height profile as prepared",
-                    q + 1, z[q], t, z_s);
-      return refuse(buf);
-    }
-  }
-  const auto at = [&](std::size_t line) {
-    return line < prog.lines.size()
-               ? static_cast<std::size_t>(prog.lines[line].raw.data() - gcode.data())
-               : gcode.size();
-  };
-  out.print_begin = at(prog.print_begin), out.print_end = at(prog.print_end);
-  out.relative_e = prog.at_print.relative_e;
-  double e = prog.at_print.e;
-  using Kind = GcodeLine::Kind;
-  for (std::size_t i = prog.print_begin; i < prog.print_end; ++i) {
-    const GcodeLine& l = prog.lines[i];
-    if (l.layer == static_cast<int>(k) && out.plate == 0) out.plate = at(i);
-    if (l.layer == static_cast<int>(k) + 1) {
-      if (out.shell == 0) out.shell = at(i), out.e = e;
-      if (l.kind == Kind::move) {
-        out.first_move = at(i);
-        break;
-      }
-      continue;
-    }
-    if (l.kind == Kind::e_reset) e = l.value;
-    if (l.kind == Kind::e_mode) out.relative_e = l.value != 0;
-    if (l.kind == Kind::text && (l.raw.rfind("M106", 0) == 0 || l.raw.rfind("M107", 0) == 0))
-      out.fan = std::string(l.raw);
-    if (l.kind != Kind::move) continue;
-    const GcodeMove& m = prog.moves[static_cast<std::size_t>(l.move)];
-    e += m.de;
-    if (!m.extruding() && m.has_e) out.retracted -= m.de;
-  }
-  if (out.first_move == 0) return refuse("the shell's layers hold no move");
-  // Supports the slicer put under the slab (it stands above the part in the 3MF) would be laid
-  // on the part with the shell; there is nothing under the shell to support.
-  for (const GcodeMove& m : prog.moves)
-    if (m.layer > static_cast<int>(k) && m.extruding() &&
-        role_from_name(m.type) == ExtrusionRole::support)
-      return refuse("supports in the shell's layers (line " + std::to_string(m.line) +
-                    "): with a shell, switch supports off or to build plate only");
-  return out;
+// Per move: whether it is the planned part's or the field's (moves outside every label:
+// travels between objects, layer changes), not another object's.
+std::vector<char> moves_of_part(const GcodeProgram& prog, const std::vector<char>& owner) {
+  std::vector<char> ours(prog.moves.size(), 1);
+  for (std::size_t i = 0; i < prog.moves.size(); ++i)
+    if (prog.moves[i].line > 0)
+      ours[i] = owner[static_cast<std::size_t>(prog.moves[i].line - 1)] != kOthers;
+  return ours;
 }
 
 // What the file must keep of the plan (settings_kept), where the part went (placement), and
@@ -368,60 +302,42 @@ Expected<Checked> checked_placement(std::string_view gcode, const std::string& b
                     " is an arc (G2/G3): switch arc fitting off (Print Settings > Advanced > "
                     "Arc fitting; OrcaSlicer: Process > Quality), arcs cannot follow curved "
                     "layers");
-  auto ours = moves_of_part(prog, plan);
-  if (!ours) return ours.error();
-  auto moved = placement(prog, *ours, plan);
+  auto owner = line_owners(prog, plan);
+  if (!owner) return owner.error();
+  const std::vector<char> ours = moves_of_part(prog, *owner);
+  auto moved = placement(prog, ours, plan);
   if (!moved) return moved.error();
-  if (auto e = settings_kept(prog, *ours, block, plan)) return *e;
+  if (auto e = settings_kept(prog, ours, block, plan)) return *e;
   Checked c;
   c.moved = *moved;
   if (!plan.shell.empty()) {
-    // The core's layers end where the shell's begin, for every object on the plate alike.
-    if (std::find(ours->begin(), ours->end(), 0) != ours->end())
-      return refuse("a shell over a planar core prints alone: the plate holds other objects");
-    auto split = shell_split(prog, gcode, plan);
+    auto split = shell_split(prog, gcode, *owner, plan);
     if (!split) return split.error();
     c.split = std::move(*split);
     return c;
   }
-  if (std::find(ours->begin(), ours->end(), 0) != ours->end()) {
+  if (std::find(ours.begin(), ours.end(), 0) != ours.end()) {
     c.options.planar_lines.assign(prog.lines.size(), 0);
-    for (std::size_t i = 0; i < prog.moves.size(); ++i)
-      if (!(*ours)[i] && prog.moves[i].line > 0)
-        c.options.planar_lines[static_cast<std::size_t>(prog.moves[i].line - 1)] = 1;
+    for (std::size_t i = 0; i < prog.lines.size(); ++i)
+      c.options.planar_lines[i] = (*owner)[i] == kOthers;
   }
   return c;
 }
 
-// A shell plan's G-code mapped as the engine route maps its two runs: the core's layers (the
-// file without the shell's and the layer under them) cut back under the shell; the shell's
-// layers (after the file's start G-code, the E, fan and retraction the file had when they
-// began) mapped onto the shell; joined.
-Expected<EngineShell> map_shell_gcode(std::string_view gcode, ShellSplit& sp, const Vec2& moved,
-                                      const SliceJob& job, const Context& ctx) {
+// A shell plan's G-code mapped as the engine route maps its two runs: the core (the file
+// without the shell's layers and the layer under them; other objects as written) cut back
+// under the shell; the shell's layers mapped onto the shell; joined.
+Expected<EngineShell> map_shell_gcode(ShellSplit& sp, const Vec2& moved, const SliceJob& job,
+                                      const Context& ctx) {
   const layers::ShellPlan& shell = sp.plan;
   sp.plan.top.origin += moved;  // H follows the part on the plate
-  std::string core_text;
-  core_text.reserve(sp.plate + gcode.size() - sp.print_end);
-  core_text.append(gcode.substr(0, sp.plate)).append(gcode.substr(sp.print_end));
-  std::string shell_text(gcode.substr(0, sp.print_begin));
-  char buf[96];
-  if (!sp.relative_e) {
-    std::snprintf(buf, sizeof buf, "G92 E%.5f\n", sp.e + sp.retracted);
-    shell_text += buf;
-  }
-  if (!sp.fan.empty()) shell_text += sp.fan + "\n";
-  shell_text.append(gcode.substr(sp.shell, sp.first_move - sp.shell));
-  if (std::abs(sp.retracted) > 1e-6) {
-    std::snprintf(buf, sizeof buf, "G1 E%.5f F2100\n", sp.relative_e ? -sp.retracted : sp.e);
-    shell_text += buf;
-  }
-  shell_text.append(gcode.substr(sp.first_move));
   const EngineRoute route{job.engine, job.print, job.layers, job.map_back};
-  auto core = map_shell_core(core_text, shell, route, ctx);
+  auto core = map_shell_core(sp.core, shell, route, ctx, std::move(sp.others));
   if (!core) return core.error();
-  return join_shell(std::move(*core), shell_text, shell, shell.core.back() + shell.t, route,
-                    "the shell's curved layers, from the slicer's layers above the core", ctx);
+  std::string().swap(sp.core);
+  return join_shell(std::move(*core), sp.shell, shell, shell.core.back() + shell.t, route,
+                    "the shell's curved layers, from the slicer's layers above the core", ctx,
+                    sp.enter_over);
 }
 
 // Whether our mark heads our header, which the time estimate's first M73 lines may precede (a
@@ -433,6 +349,19 @@ bool post_processed(std::string_view gcode) {
 }
 
 }  // namespace
+
+std::optional<Vec2> post_processed_centre(std::string_view gcode) {
+  if (!post_processed(gcode)) return std::nullopt;
+  const std::string_view head = gcode.substr(0, gcode.find("\n;LAYER_CHANGE"));
+  const std::size_t at = head.find(kPartCentredAt);
+  double x = 0, y = 0;
+  if (at == std::string_view::npos ||
+      std::sscanf(std::string(head.substr(at + kPartCentredAt.size(), 80)).c_str(), "%lf, %lf", &x,
+                  &y) != 2 ||
+      !std::isfinite(x) || !std::isfinite(y))
+    return std::nullopt;
+  return Vec2(x, y);
+}
 
 std::vector<std::string> gcode_object_names(std::string_view gcode) {
   std::vector<std::string> names;
@@ -476,7 +405,7 @@ Expected<PostProcessed> post_process_gcode(std::string_view gcode, const PrintPl
   SliceResult r;
   std::string body;
   if (checked->split) {
-    auto joined = map_shell_gcode(gcode, *checked->split, moved, job, ctx);
+    auto joined = map_shell_gcode(*checked->split, moved, job, ctx);
     if (!joined) return joined.error();
     r.layers = std::move(joined->layers);
     body = std::move(joined->gcode);
@@ -492,6 +421,10 @@ Expected<PostProcessed> post_process_gcode(std::string_view gcode, const PrintPl
                 kPostProcessedMark.data(), "0.1.0", plan.object.c_str(), plan.model.c_str(),
                 moved.x(), moved.y());
   std::string head = buf;
+  const Vec2 centre = 0.5 * (plan.box.min + plan.box.max).head<2>() + moved;
+  std::snprintf(buf, sizeof buf, "%s%.3f, %.3f mm on the plate\n", kPartCentredAt.data(),
+                centre.x(), centre.y());
+  head += buf;
   for (const std::string& h : plan.header) head += "; " + h + "\n";
   r.gcode = head + body;
   std::string breach;
@@ -504,6 +437,16 @@ Expected<PostProcessed> post_process_gcode(std::string_view gcode, const PrintPl
       },
       ctx);
   if (!ok) return ok.error();
+  // A shell prints after everything else on the plate: an object near it standing higher
+  // is in the head's way.
+  if (!*ok && checked->split && checked->split->enter_over) {
+    std::snprintf(buf, sizeof buf, "%.0f", job.check.toolhead.reach());
+    return Error{Status::internal_error,
+                 "safety check: " + breach + "; the shell prints after the plate's other " +
+                     "objects, and one standing within " + buf + " mm of " + plan.object +
+                     " (the print head's reach) may be in its way: move them farther apart or " +
+                     "print them separately; the file is left as the slicer wrote it"};
+  }
   if (!*ok)
     return Error{Status::internal_error,
                  "safety check: " + breach +
@@ -511,6 +454,13 @@ Expected<PostProcessed> post_process_gcode(std::string_view gcode, const PrintPl
                      "--check-with prusaslicer and this profile: the patches its paths break "
                      "then stay planar)"};
   PostProcessed out;
+  if (checked->split && checked->split->supports_left_out > 0) {
+    std::snprintf(buf, sizeof buf,
+                  "left out %.0f mm of supports the slicer put under the shell's layers (they "
+                  "stood above the part in the 3MF; the shell lies on the core there)",
+                  checked->split->supports_left_out);
+    out.notices.push_back(buf);
+  }
   // The gate measured them (job.print is *cfg).
   out.gcode = r.stats_in_gcode ? std::move(r.gcode) : with_print_stats(r.gcode, *cfg, &out.stats);
   if (r.stats_in_gcode) out.stats = r.stats;

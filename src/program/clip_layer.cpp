@@ -61,7 +61,8 @@ Pieces cut_move(const G& g, double len, int n, double slope) {
 
 int clip_layer(LayerWork& w, const std::function<double(double, double)>& margin,
                const std::function<double(const Vec2&, const Vec2&)>& slope_bound,
-               const GcodeRetraction& ret, const LayerPassParams& params, std::size_t& samples) {
+               const GcodeRetraction& ret, const LayerPassParams& params, std::size_t& samples,
+               const std::function<bool(const GcodeMove&)>& untouched) {
   std::vector<GcodeLine> out;
   out.reserve(w.lines.size());
   // The give-back of a retraction around cut-away travel: held while the travel goes on (the
@@ -73,7 +74,8 @@ int clip_layer(LayerWork& w, const std::function<double(double, double)>& margin
   };
   for (const GcodeLine& it : w.lines) {
     if (it.kind != GcodeLine::Kind::move ||
-        !w.moves[static_cast<std::size_t>(it.move)].extruding()) {
+        !w.moves[static_cast<std::size_t>(it.move)].extruding() ||
+        (untouched && untouched(w.moves[static_cast<std::size_t>(it.move)]))) {
       settle();
       out.push_back(it);
       continue;

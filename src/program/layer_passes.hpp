@@ -54,10 +54,12 @@ void order_top_skins(LayerWork& layer, const LayerPassParams& p);
 /// `mapped` entries of new moves are empty. slope_bound(lo, hi), when given, is at least
 /// |∇margin| anywhere in the box [lo, hi] (mm per mm): a move whose margin at its start is
 /// farther from 0 than that slope can take it over its length is kept or cut whole without
-/// its steps being looked at (the steps would all have said the same).
+/// its steps being looked at (the steps would all have said the same). Moves `untouched`
+/// says are kept whole (another object on the plate), when it is given.
 int clip_layer(LayerWork& layer, const std::function<double(double x, double y)>& margin,
                const std::function<double(const Vec2& lo, const Vec2& hi)>& slope_bound,
-               const GcodeRetraction& ret, const LayerPassParams& p, std::size_t& samples);
+               const GcodeRetraction& ret, const LayerPassParams& p, std::size_t& samples,
+               const std::function<bool(const GcodeMove&)>& untouched = {});
 
 /// A layer the clip left nothing of, as steps (into `out`): only what it tells the printer
 /// (M-codes: temperatures, E mode); not the fan, which follows the layers printed instead (and

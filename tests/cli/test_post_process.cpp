@@ -3,6 +3,7 @@
 // the G-code back. Run with Debian's prusa-slicer as a user would; skipped without it.
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <cstdlib>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -343,9 +344,71 @@ TEST(PostProcessRoute, AShellRefusesLayersOffItsProfile) {
   EXPECT_EQ(test::read_bytes(out), before);
 }
 
+// A shell on a plate with other objects: they print with the core as the slicer wrote them,
+// and the shell after them all. A shorter object beside it is no matter; a taller one within
+// the head's reach is (refused, naming it); the same one farther off is not. check places the
+// mesh where the header says the slicer put it.
+TEST(PostProcessRoute, AShellPrintsAfterTheOtherObjectsOnThePlate) {
+  if (!have_prusaslicer()) GTEST_SKIP() << "prusa-slicer not installed";
+  const fs::path dir = test::temp_dir("pp_shell_plate");
+  ASSERT_TRUE(write_stl(dir / "rib.stl", test::rib()));
+  ASSERT_TRUE(write_stl(dir / "cube.stl", test::box({0, 0, 0}, {15, 15, 6})));
+  ASSERT_TRUE(write_stl(dir / "tower.stl", test::box({0, 0, 0}, {10, 10, 25})));
+  ASSERT_TRUE(write_stl(dir / "far.stl", test::box({170, 160, 0}, {180, 170, 25})));
+  const fs::path plan = dir / "rib.3mf", out = dir / "plate.gcode";
+  const auto p = test::run_cli("prepare " + (dir / "rib.stl").string() + " -o " + plan.string());
+  ASSERT_EQ(p.code, 0) << p.err;
+  auto slice = [&](const std::string& other, const std::string& how) {
+    return prusa("--export-gcode --gcode-label-objects --merge --first-layer-height " +
+                 first_layer(p.err) + " " + how + " -o " + out.string() + " " + plan.string() +
+                 " " + (dir / other).string());
+  };
+  const auto run = [&] {
+    return test::run_cli("post-process --plan " + plan.string() + " " + out.string());
+  };
+  ASSERT_EQ(slice("cube.stl", ""), 0);
+  const std::string before = test::read_bytes(out);
+  const auto r = run();
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string after = test::read_bytes(out);
+  const auto cube = lines_of_object(before, "cube");
+  EXPECT_GT(cube.size(), 100u);
+  EXPECT_EQ(lines_of_object(after, "cube"), cube);
+  EXPECT_EQ(after.find("the part moved by -10.000, -10.000 mm"), std::string::npos);  // arranged
+  const auto ours = figures(out, dir / "rib.stl");
+  EXPECT_LE(ours["top_surface_deviation"]["p95"].get<double>(), 0.005);
+  EXPECT_EQ(ours["collisions"], 0);
+  EXPECT_GT(ours["steepest_extrusion"].get<double>(), 10);  // curved
+  // The tower, arranged beside the rib, stands 7 mm from it and 13 mm above its top.
+  ASSERT_EQ(slice("tower.stl", ""), 0);
+  const std::string tower = test::read_bytes(out);
+  const auto t = run();
+  EXPECT_EQ(t.code, 2);
+  EXPECT_NE(t.err.find("may be in its way: move them farther apart or print them separately"),
+            std::string::npos)
+      << t.err;
+  EXPECT_EQ(test::read_bytes(out), tower);
+  ASSERT_EQ(slice("far.stl", "--dont-arrange"), 0);
+  const auto f = run();
+  ASSERT_EQ(f.code, 0) << f.err;
+  const auto far = figures(out, dir / "rib.stl");
+  EXPECT_NEAR(far["top_surface_deviation"]["p95"].get<double>(),
+              ours["top_surface_deviation"]["p95"].get<double>(), 1e-3);
+  EXPECT_EQ(far["collisions"], 0);
+  // The shell is entered from over the tower's top, not by going down through it.
+  const std::string text = test::read_bytes(out);
+  const auto entry = text.find("; nonplanar: the shell's curved layers");
+  ASSERT_NE(entry, std::string::npos);
+  double top = 0;
+  ASSERT_EQ(std::sscanf(text.c_str() + text.find('\n', entry) + 1, "G1 Z%lf", &top), 1);
+  EXPECT_GT(top, 25.0);
+}
+
 // Supports PrusaSlicer puts under the slab (which stands above the part in the 3MF) would be
-// laid on the part with the shell: refused, naming the setting; build plate only prints.
-TEST(PostProcessRoute, AShellRefusesSupportsUnderItsSlab) {
+// laid on the part with the shell: those in the shell's layers are left out (as the engine
+// route's slab run has none), those in the core's layers where the shell goes are cut with the
+// core; the shell prints as without them.
+TEST(PostProcessRoute, AShellLeavesOutSupportsUnderItsSlab) {
   if (!have_prusaslicer()) GTEST_SKIP() << "prusa-slicer not installed";
   const fs::path dir = test::temp_dir("pp_shell_supports");
   ASSERT_TRUE(write_stl(dir / "rib.stl", test::rib()));
@@ -356,13 +419,25 @@ TEST(PostProcessRoute, AShellRefusesSupportsUnderItsSlab) {
                             " --support-material -o " + out.string() + " ";
   ASSERT_EQ(prusa(slice + plan.string()), 0);
   const std::string before = test::read_bytes(out);
+  const auto shell_layers = before.find("\n;Z:12.1\n");
+  ASSERT_NE(shell_layers, std::string::npos);
+  ASSERT_NE(before.find(";TYPE:Support material", shell_layers), std::string::npos);
   const auto r = test::run_cli("post-process --plan " + plan.string() + " " + out.string());
-  EXPECT_EQ(r.code, 2);
-  EXPECT_NE(r.err.find("supports in the shell's layers"), std::string::npos) << r.err;
-  EXPECT_EQ(test::read_bytes(out), before);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("notice: left out "), std::string::npos) << r.err;
+  const std::string after = test::read_bytes(out);
+  const auto shell = after.find("; nonplanar: the shell's curved layers");
+  ASSERT_NE(shell, std::string::npos);
+  EXPECT_EQ(after.find(";TYPE:Support material\n", shell), std::string::npos);
+  const auto with = figures(out, dir / "rib.stl");
+  EXPECT_LE(with["top_surface_deviation"]["p95"].get<double>(), 0.005);
+  EXPECT_EQ(with["collisions"], 0);
   ASSERT_EQ(prusa(slice + "--support-material-buildplate-only " + plan.string()), 0);
   const auto ok = test::run_cli("post-process --plan " + plan.string() + " " + out.string());
   EXPECT_EQ(ok.code, 0) << ok.err;
+  EXPECT_EQ(ok.err.find("notice: left out "), std::string::npos) << ok.err;
+  EXPECT_NEAR(figures(out, dir / "rib.stl")["top_surface_deviation"]["p95"].get<double>(),
+              with["top_surface_deviation"]["p95"].get<double>(), 1e-3);
 }
 
 TEST(PrepareCli, APartWithNothingToPlanIsRefused) {

@@ -1,0 +1,47 @@
+// Where a shell plan's G-code splits (prepare_shell in prepare_part.cpp): the planned part's
+// core, in layers with tops on the plan's boundaries up to z_s; its layer z_s … z_s + t that
+// held the shell's slab up in the 3MF (dropped); its shell's layers, t thick. Other objects on
+// the plate print with the core, as the slicer wrote them.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "layers/shell_plan.hpp"
+#include "nonplanar/print_plan.hpp"
+#include "nonplanar/program.hpp"
+
+namespace nonplanar {
+
+/// Whose each line of a program is, by the slicer's object labels: 0 outside every label
+/// (layer changes), 1 the planned part's, 2 another object's.
+enum LineOwner : char { kUnlabelled = 0, kOurs = 1, kOthers = 2 };
+
+struct ShellSplit {
+  layers::ShellPlan plan;  ///< the plan's shell, where prepare placed the part
+  /// The file without the planned part's lines above z_s (the layers only it prints there go
+  /// whole), as a program of its own (program/splice_lines.hpp).
+  std::string core;
+  /// Per line of `core`: 1 where another object's (kept as written), else 0.
+  std::vector<char> others;
+  /// The file's start G-code, then the layers of the shell (the planned part's lines and
+  /// the layer changes), then its end G-code; a program of its own.
+  std::string shell;
+  /// Where the shell's first move goes (XY, mm) when the plate holds other objects: the
+  /// shell is entered from over them (join_shell). None for the part alone.
+  std::optional<Vec2> enter_over;
+  /// Support extrusions the slicer put in the shell's layers (under the slab, which stands
+  /// above the part in the 3MF), left out as the engine route's slab run has none; mm of them.
+  double supports_left_out = 0;
+};
+
+/// Inputs: the file read (`prog` from `gcode`), whose each line is (size = prog.lines), the
+/// plan. Output: the split; refused (invalid_argument, one line) when the part's layers above
+/// z_s are not the plan's (no layer ends at z_s + t, a shell layer off the t grid) or the
+/// shell's layers hold nothing but supports.
+Expected<ShellSplit> shell_split(const GcodeProgram& prog, std::string_view gcode,
+                                 const std::vector<char>& owner, const PrintPlan& plan);
+
+}  // namespace nonplanar
