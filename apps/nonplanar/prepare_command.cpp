@@ -146,7 +146,9 @@ int run(const PrepareOptions& o) {
   }
   part->plan.object = fs::path(o.mesh.model).stem().string();
   part->plan.model = fs::path(o.mesh.model).filename().string();
-  Object3mf object{part->plan.object, {{"layer_height", num(part->plan.layer_height)}}};
+  Object3mf object{part->plan.object, {{"layer_height", num(part->plan.layer_height)}}, {}};
+  if (!part->support_blocker.faces.empty())
+    object.support_blockers.push_back(part->support_blocker);
   std::vector<PackageFile> files{{"/Metadata/nonplanar_plan.json", plan_json(part->plan)}};
   // A shell's core layers: PrusaSlicer's profile, and the same under the name OrcaSlicer and
   // Bambu Studio read (their 3MF's Metadata/layer_heights_profile.txt; untested here).

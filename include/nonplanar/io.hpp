@@ -61,10 +61,16 @@ struct Object3mf {
   /// reads too), e.g. {"layer_height", "0.2"}: they go with the object, whatever preset the
   /// user picks.
   std::vector<std::pair<std::string, std::string>> settings;
+  /// Volumes of the object under which the slicer generates no supports (PrusaSlicer's
+  /// volume_type SupportBlocker), in the mesh's coordinates. Their faces follow the mesh's in
+  /// the object; our reader leaves them out.
+  std::vector<TriangleMesh> support_blockers;
 };
 
 /// 3MF writer: one mesh object, one build item with no transform, and `extra` files (e.g.
-/// PrusaSlicer's layer-height profile). Atomic.
+/// PrusaSlicer's layer-height profile). Atomic. The 3MF reader (load_mesh) leaves out the
+/// triangles of an object's volumes that PrusaSlicer's config marks as no part (modifiers,
+/// support blockers and enforcers, negative volumes).
 Expected<void> write_3mf(const std::filesystem::path& file, const TriangleMesh& mesh,
                          const std::vector<PackageFile>& extra = {}, const Object3mf& object = {});
 

@@ -57,6 +57,10 @@ struct PreparedPart {
   /// PrusaSlicer's layer-height profile for the part (Slic3r_PE_layer_heights_profile.txt;
   /// empty: none, the layers are the plan's layer_height).
   std::string layer_heights_profile;
+  /// A shell's support blocker: a box over the part from just above the core's last boundary
+  /// up, where the slicer would otherwise support the slab's underside (it stands above the
+  /// part in the 3MF) and the columns under it. Empty without a shell.
+  TriangleMesh support_blocker;
 };
 
 /// Inputs: the part placed on the bed, the job (its engine slices the plan to check it,

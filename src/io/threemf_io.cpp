@@ -196,7 +196,31 @@ std::string object_name(NMR::PLib3MFModelObjectResource* obj) {
 struct ConfigObject {
   DWORD id = 0, instances = 1;
   std::string name;
+  /// Its volumes that are no part (modifiers, support blockers and enforcers, negative
+  /// volumes): their first and last triangle in the object's mesh.
+  std::vector<std::pair<std::size_t, std::size_t>> not_part;
 };
+
+// The triangle ranges of an object's volumes whose type is not a model part (PrusaSlicer:
+// key "volume_type" other than "ModelPart", or the older "modifier" = 1).
+std::vector<std::pair<std::size_t, std::size_t>> volumes_not_part(std::string_view obj) {
+  std::vector<std::pair<std::size_t, std::size_t>> out;
+  const std::string_view open = "<volume firstid=\"";
+  for (std::size_t at = obj.find(open); at != std::string_view::npos; at = obj.find(open, at + 1)) {
+    const std::size_t end = std::min(obj.find("</volume>", at), obj.size());
+    const std::string_view v = obj.substr(at, end - at);
+    const bool part =
+        v.find("key=\"volume_type\"") == std::string_view::npos
+            ? v.find("key=\"modifier\" value=\"1\"") == std::string_view::npos
+            : v.find("key=\"volume_type\" value=\"ModelPart\"") != std::string_view::npos;
+    const std::size_t last = v.find("lastid=\"");
+    if (part || last == std::string_view::npos) continue;
+    const unsigned long first = std::strtoul(v.data() + open.size(), nullptr, 10);
+    const unsigned long final = std::strtoul(v.data() + last + 8, nullptr, 10);
+    if (first <= final) out.emplace_back(first, final);
+  }
+  return out;
+}
 std::vector<ConfigObject> config_objects(std::string_view zip) {
   std::vector<ConfigObject> out;
   for (const char* entry : {"Metadata/Slic3r_PE_model.config", "Metadata/model_settings.config"}) {
@@ -208,8 +232,8 @@ std::vector<ConfigObject> config_objects(std::string_view zip) {
       const std::size_t end = s.find("</object>", at);
       const std::string_view obj = s.substr(at, end == std::string_view::npos ? 0 : end - at);
       const std::size_t key = obj.find("key=\"name\" value=\"");
-      if (key == std::string_view::npos) continue;
-      const std::size_t v0 = key + 18, v1 = obj.find('"', v0);
+      const std::size_t v0 = key + 18;
+      const std::size_t v1 = key == std::string_view::npos ? v0 : obj.find('"', v0);
       if (v1 == std::string_view::npos) continue;
       ConfigObject c;
       c.id = static_cast<DWORD>(std::strtoul(obj.data() + open.size(), nullptr, 10));
@@ -217,7 +241,9 @@ std::vector<ConfigObject> config_objects(std::string_view zip) {
       if (n != std::string_view::npos)
         c.instances = static_cast<DWORD>(
             std::clamp(std::strtoul(obj.data() + n + 17, nullptr, 10), 1ul, 1000000ul));
-      c.name = std::string(obj.substr(v0, std::min<std::size_t>(v1 - v0, 200)));
+      if (key != std::string_view::npos)
+        c.name = std::string(obj.substr(v0, std::min<std::size_t>(v1 - v0, 200)));
+      c.not_part = volumes_not_part(obj);
       out.push_back(std::move(c));
     }
   }
@@ -234,29 +260,73 @@ class ItemNames {
                      [](const ConfigObject& a, const ConfigObject& b) { return a.id < b.id; });
   }
   PlateObject next(NMR::PLib3MFModelObjectResource* obj, std::size_t item) {
-    DWORD id = 0;
-    NMR::lib3mf_resource_getresourceid(obj, &id);
     PlateObject p;
     p.name = object_name(obj);
-    std::uint64_t source = (std::uint64_t(1) << 32) | id;  // the resource itself
-    // The config object with the greatest first id at or below this one, if it reaches it.
-    auto c = std::upper_bound(config_.begin(), config_.end(), id,
-                              [](DWORD v, const ConfigObject& o) { return v < o.id; });
-    if (c != config_.begin() && id - (--c)->id < c->instances) {
-      source = static_cast<std::uint64_t>(c - config_.begin());
-      if (p.name.empty()) p.name = c->name;
-    }
+    const ConfigObject* c = config_of(obj);
+    // The config object's index, else the resource itself.
+    const std::uint64_t source =
+        c ? static_cast<std::uint64_t>(c - config_.data()) : (std::uint64_t(1) << 32) | id_of(obj);
+    if (c && p.name.empty()) p.name = c->name;
     if (p.name.empty()) p.name = "object " + std::to_string(item + 1);
     const auto [it, fresh] = ids_.emplace(source, static_cast<int>(ids_.size()));
     p.id = it->second;
     p.copy = copies_[source]++;
     return p;
   }
+  /// The object's triangles that are no part (ConfigObject::not_part); empty when none.
+  std::vector<std::pair<std::size_t, std::size_t>> not_part(
+      NMR::PLib3MFModelObjectResource* obj) const {
+    const ConfigObject* c = config_of(obj);
+    return c ? c->not_part : std::vector<std::pair<std::size_t, std::size_t>>{};
+  }
 
  private:
+  static DWORD id_of(NMR::PLib3MFModelObjectResource* obj) {
+    DWORD id = 0;
+    NMR::lib3mf_resource_getresourceid(obj, &id);
+    return id;
+  }
+  // The config object with the greatest first id at or below this one, if it reaches it.
+  const ConfigObject* config_of(NMR::PLib3MFModelObjectResource* obj) const {
+    const DWORD id = id_of(obj);
+    auto c = std::upper_bound(config_.begin(), config_.end(), id,
+                              [](DWORD v, const ConfigObject& o) { return v < o.id; });
+    if (c != config_.begin() && id - (--c)->id < c->instances) return &*c;
+    return nullptr;
+  }
+
   std::vector<ConfigObject> config_;
   std::unordered_map<std::uint64_t, int> ids_, copies_;
 };
+
+// The object just appended (its vertices and faces from first_vertex, first_face) without
+// the faces of `ranges` (its triangle numbers) and the vertices only they used: a modifier or
+// a support blocker is no part of what prints.
+void drop_volumes(TriangleMesh& m, std::size_t first_vertex, std::size_t first_face,
+                  const std::vector<std::pair<std::size_t, std::size_t>>& ranges) {
+  if (ranges.empty()) return;
+  std::vector<char> dropped(m.faces.size() - first_face, 0);
+  for (const auto& [a, b] : ranges)
+    for (std::size_t f = a; f <= b && f < dropped.size(); ++f) dropped[f] = 1;
+  const std::vector<Vec3> old(m.vertices.begin() + static_cast<long>(first_vertex),
+                              m.vertices.end());
+  m.vertices.resize(first_vertex);
+  std::vector<int> renumbered(old.size(), -1);
+  std::size_t faces = first_face;
+  for (std::size_t f = first_face; f < m.faces.size(); ++f) {
+    if (dropped[f - first_face]) continue;
+    for (int& v : m.faces[f]) {
+      int& r = renumbered[static_cast<std::size_t>(v) - first_vertex];
+      if (r < 0) {
+        r = static_cast<int>(m.vertices.size());
+        m.vertices.push_back(old[static_cast<std::size_t>(v) - first_vertex]);
+      }
+      v = r;
+    }
+    m.faces[faces++] = m.faces[f];
+  }
+  m.faces.resize(faces);
+}
 
 Expected<TriangleMesh> parse_package(std::string_view data, std::size_t max_triangles,
                                      PlateObjects* objects) {
@@ -297,7 +367,7 @@ Expected<TriangleMesh> parse_package(std::string_view data, std::size_t max_tria
   Handle again;
   if (NMR::lib3mf_model_getbuilditems(model.p, &again.p) != 0)
     return Error{Status::parse_error, "3MF build has no items"};
-  std::optional<ItemNames> names;  // read when first needed
+  ItemNames names(data);
   mesh.vertices.reserve(static_cast<std::size_t>(3 * triangles));
   mesh.faces.reserve(static_cast<std::size_t>(triangles));
   while (NMR::lib3mf_builditemiterator_movenext(again.p, &has_next) == 0 && has_next) {
@@ -315,12 +385,13 @@ Expected<TriangleMesh> parse_package(std::string_view data, std::size_t max_tria
       if (!xf.matrix().allFinite())
         return Error{Status::parse_error, "3MF build item: its transform is not finite"};
     }
+    const std::size_t first_vertex = mesh.vertices.size(), first_face = mesh.faces.size();
     if (!append_object(obj.p, xf, mesh, 0, &err))
       return Error{Status::parse_error, "3MF object: " + err};
+    drop_volumes(mesh, first_vertex, first_face, names.not_part(obj.p));
     if (objects) {
-      if (!names) names.emplace(data);
       objects->face.resize(mesh.faces.size(), static_cast<int>(objects->items.size()));
-      objects->items.push_back(names->next(obj.p, objects->items.size()));
+      objects->items.push_back(names.next(obj.p, objects->items.size()));
     }
   }
   DWORD unit = NMR::MODELUNIT_MILLIMETER;
@@ -399,7 +470,7 @@ std::string xml_escaped(const std::string& s) {
 }
 
 // PrusaSlicer's per-object configuration for object `id` (its name and settings, one volume
-// of all the faces).
+// of the part's faces, then one per support blocker).
 std::string slic3r_model_config(unsigned id, std::size_t faces, const Object3mf& o) {
   std::string s = "<?xml version=\"1.0\" encoding=\"utf-8\"?>\n<config>\n <object id=\"" +
                   std::to_string(id) + "\" instances_count=\"1\">\n";
@@ -412,8 +483,27 @@ std::string slic3r_model_config(unsigned id, std::size_t faces, const Object3mf&
   s += "  <volume firstid=\"0\" lastid=\"" + std::to_string(faces ? faces - 1 : 0) + "\">\n";
   if (!o.name.empty())
     s += "   <metadata type=\"volume\" key=\"name\" value=\"" + xml_escaped(o.name) + "\"/>\n";
-  s += "  </volume>\n </object>\n</config>\n";
+  s += "  </volume>\n";
+  std::size_t first = faces;
+  for (const TriangleMesh& b : o.support_blockers) {
+    if (b.faces.empty()) continue;
+    s += "  <volume firstid=\"" + std::to_string(first) + "\" lastid=\"" +
+         std::to_string(first + b.faces.size() - 1) + "\">\n";
+    s += "   <metadata type=\"volume\" key=\"name\" value=\"support blocker\"/>\n";
+    s += "   <metadata type=\"volume\" key=\"volume_type\" value=\"SupportBlocker\"/>\n";
+    s += "  </volume>\n";
+    first += b.faces.size();
+  }
+  s += " </object>\n</config>\n";
   return s;
+}
+
+// The part, then the support blockers: the object's volumes in the order of its faces.
+std::vector<const TriangleMesh*> all_volumes(const TriangleMesh& mesh, const Object3mf& o) {
+  std::vector<const TriangleMesh*> out{&mesh};
+  for (const TriangleMesh& b : o.support_blockers)
+    if (!b.faces.empty()) out.push_back(&b);
+  return out;
 }
 
 }  // namespace
@@ -426,12 +516,21 @@ Expected<void> write_3mf(const std::filesystem::path& file, const TriangleMesh& 
   if (NMR::lib3mf_createmodel(&model.p) != 0 ||
       NMR::lib3mf_model_addmeshobject(model.p, &obj.p) != 0)
     return Error{Status::internal_error, file.string() + ": cannot create a 3MF model"};
-  std::vector<NMR::MODELMESHVERTEX> verts(mesh.vertices.size());
-  for (std::size_t i = 0; i < verts.size(); ++i)
-    for (int k = 0; k < 3; ++k) verts[i].m_fPosition[k] = static_cast<float>(mesh.vertices[i][k]);
-  std::vector<NMR::MODELMESHTRIANGLE> tris(mesh.faces.size());
-  for (std::size_t i = 0; i < tris.size(); ++i)
-    for (int k = 0; k < 3; ++k) tris[i].m_nIndices[k] = static_cast<DWORD>(mesh.faces[i][k]);
+  std::vector<NMR::MODELMESHVERTEX> verts;
+  std::vector<NMR::MODELMESHTRIANGLE> tris;
+  for (const TriangleMesh* m : all_volumes(mesh, object)) {
+    const auto base = static_cast<DWORD>(verts.size());
+    for (const Vec3& v : m->vertices) {
+      NMR::MODELMESHVERTEX w;
+      for (int k = 0; k < 3; ++k) w.m_fPosition[k] = static_cast<float>(v[k]);
+      verts.push_back(w);
+    }
+    for (const auto& f : m->faces) {
+      NMR::MODELMESHTRIANGLE t;
+      for (int k = 0; k < 3; ++k) t.m_nIndices[k] = base + static_cast<DWORD>(f[k]);
+      tris.push_back(t);
+    }
+  }
   if (NMR::lib3mf_meshobject_setgeometry(obj.p, verts.data(), static_cast<DWORD>(verts.size()),
                                          tris.data(), static_cast<DWORD>(tris.size())) != 0 ||
       NMR::lib3mf_model_addbuilditem(model.p, obj.p, nullptr, &item.p) != 0 ||
@@ -439,7 +538,7 @@ Expected<void> write_3mf(const std::filesystem::path& file, const TriangleMesh& 
     return Error{Status::internal_error, file.string() + ": " + io::last_error(model.p)};
   if (!object.name.empty() && NMR::lib3mf_object_setnameutf8(obj.p, object.name.c_str()) != 0)
     return Error{Status::internal_error, file.string() + ": " + io::last_error(model.p)};
-  if (!object.name.empty() || !object.settings.empty()) {
+  if (!object.name.empty() || !object.settings.empty() || !object.support_blockers.empty()) {
     DWORD id = 0;
     NMR::lib3mf_resource_getresourceid(obj.p, &id);
     extra.push_back(

@@ -56,6 +56,34 @@ TEST(ThreeMf, RoundTrip) {
   EXPECT_TRUE(r->defects.closed());
 }
 
+// A support blocker is a volume of the object, after the part's faces, that the slicer does
+// not print: PrusaSlicer's config marks it, and our reader leaves it (faces and vertices) out.
+TEST(ThreeMf, ASupportBlockerIsNoPartOfTheMesh) {
+  const auto dir = test::temp_dir("3mf_blocker");
+  const TriangleMesh part =
+      test::height_field_solid([](double x, double) { return 4 + 0.2 * x; }, 0, 10, 0, 5, 4, 3);
+  Object3mf o{"ramp", {{"layer_height", "0.2"}}, {test::box({-1, -1, 5}, {11, 6, 8})}};
+  ASSERT_TRUE(write_3mf(dir / "b.3mf", part, {}, o));
+  auto cfg = read_3mf_part(dir / "b.3mf", "Metadata/Slic3r_PE_model.config");
+  ASSERT_TRUE(cfg) << cfg.error().message;
+  const std::string last = std::to_string(part.faces.size() - 1);
+  EXPECT_NE(cfg->find("<volume firstid=\"0\" lastid=\"" + last + "\">"), std::string::npos) << *cfg;
+  EXPECT_NE(cfg->find("<volume firstid=\"" + std::to_string(part.faces.size()) + "\" lastid=\"" +
+                      std::to_string(part.faces.size() + 11) + "\">"),
+            std::string::npos)
+      << *cfg;
+  EXPECT_NE(cfg->find("key=\"volume_type\" value=\"SupportBlocker\""), std::string::npos);
+  auto r = load_mesh(dir / "b.3mf", test::unplaced(), {});
+  ASSERT_TRUE(r) << r.error().message;
+  EXPECT_EQ(r->mesh.faces.size(), part.faces.size());
+  EXPECT_NEAR(signed_volume(r->mesh), signed_volume(part), 1e-4);
+  const BoundingBox box = bounding_box(r->mesh);
+  EXPECT_NEAR(box.max.z(), 6.0, 1e-4);  // the blocker's 8 mm and -1 mm are gone
+  EXPECT_NEAR(box.min.x(), 0.0, 1e-4);
+  EXPECT_TRUE(r->defects.closed());
+  EXPECT_FALSE(r->objects.several());
+}
+
 // Two build items of one object, each with its own transform: both must come in, moved.
 TEST(ThreeMf, BuildItemsAndTransformsAreApplied) {
   const auto dir = test::temp_dir("3mf_transform");

@@ -68,7 +68,7 @@ TEST(ZipPackage, PartsOfOurOwn3mfReadBack) {
   const std::string plan(300000, 'x');
   ASSERT_TRUE(write_3mf(d / "p.3mf", test::box({0, 0, 0}, {20, 10, 5}),
                         {{"/Metadata/nonplanar_plan.json", plan}},
-                        {"part", {{"layer_height", "0.2"}}}));
+                        {"part", {{"layer_height", "0.2"}}, {}}));
   auto back = read_3mf_part(d / "p.3mf", "Metadata/nonplanar_plan.json");
   ASSERT_TRUE(back) << back.error().message;
   EXPECT_EQ(*back, plan);

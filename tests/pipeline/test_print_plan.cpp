@@ -303,6 +303,16 @@ TEST(PrintPlan, AShellIsPreparedAsThePartWithItsSlabAbove) {
   EXPECT_NEAR(box.min.x(), part_box.min.x(), 1e-9);
   EXPECT_NEAR(box.max.y(), part_box.max.y(), 1e-9);
   EXPECT_EQ(part->plan.first_layer_height, shell->core[1]);
+  // The support blocker: over the part from just above z_s (the slab's first layer is sliced
+  // at z_s + t/2, the core's last below z_s) to over the slab, a little wider than the part.
+  const BoundingBox blocker = bounding_box(part->support_blocker);
+  ASSERT_EQ(part->support_blocker.faces.size(), 12u);
+  EXPECT_GT(blocker.min.z(), z_s);
+  EXPECT_LT(blocker.min.z(), z_s + 0.5 * t);
+  EXPECT_GT(blocker.max.z(), box.max.z());
+  EXPECT_LT(blocker.min.x(), box.min.x());
+  EXPECT_GT(blocker.max.y(), box.max.y());
+  EXPECT_NEAR(signed_volume(part->support_blocker), blocker.size().prod(), 1e-6);
   // One layer a boundary: the core's, then every t up to the slab's top.
   const std::string& prof = part->layer_heights_profile;
   EXPECT_EQ(prof.rfind("object_id=1|", 0), 0u);
