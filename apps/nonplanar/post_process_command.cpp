@@ -133,7 +133,8 @@ void register_post_process(CLI::App& app, std::function<int()>* run_fn) {
       "post-processing scripts. The plan is the prepared 3MF (--plan), else a 3MF beside the\n"
       "G-code named after its object labels or after the G-code. Refused with one line and\n"
       "the file untouched when the slicer changed what the plan needs (layer heights, arcs,\n"
-      "scale or rotation).");
+      "scale or rotation). Other objects on the plate (told apart by the slicer's object\n"
+      "labels) stay as the slicer wrote them; a curved shell prints after them.");
   cmd->add_option("gcode", o->gcode, "The G-code file (the slicer passes it)")->required();
   cmd->add_option("--plan", o->plan, "The 3MF 'nonplanar prepare' wrote (or its plan JSON)");
   cmd->add_option("-o,--output", o->output, "Write here instead of in place (atomically)");
