@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <future>
 #include <map>
+#include <optional>
 
 #include "engine/external_engine.hpp"
 #include "nonplanar/deform.hpp"
@@ -180,26 +181,36 @@ Expected<EngineShell> shell_with_engine(const TriangleMesh& mesh, const layers::
                     "the shell's curved layers, from the engine's second run", ctx);
 }
 
+namespace {
+
+// Where the first move of a program's print that goes somewhere in XY goes (none without).
+std::optional<Vec2> first_xy(std::string_view text) {
+  const GcodeProgram prog = read_gcode_program(text);
+  for (const GcodeMove& m : prog.moves)
+    if (m.layer >= 0 && m.has_xy) return Vec2(m.to.head<2>());
+  return std::nullopt;
+}
+
+}  // namespace
+
 Expected<EngineShell> join_shell(ForeignGcode core, std::string_view shell_text,
                                  const layers::ShellPlan& plan, double base, const EngineRoute& job,
-                                 const std::string& note, const Context& ctx,
-                                 const std::optional<Vec2>& enter_over) {
-  // Entered from where the core ended, or from over everything printed.
+                                 const std::string& note, const Context& ctx) {
   const layers::ShellPathField path_field(plan, base);
   ctx.progress("map back", 0);
   ForeignMapOptions shell_opt;
   shell_opt.start = core.end_at;
   std::string entry;
-  if (enter_over) {
+  if (const auto over = first_xy(shell_text)) {
     double top = core.end_at.z();
     for (const LayerToolpaths& L : core.layers) top = std::max(top, L.max_z);
     top += job.map_back.travel_lift;
     char buf[160];
     std::snprintf(buf, sizeof buf, "G1 Z%.3f F%.0f\nG1 X%.3f Y%.3f F%.0f\n", top,
-                  60 * std::min(job.print.paths.travel_speed, 20.0), enter_over->x(),
-                  enter_over->y(), 60 * job.print.paths.travel_speed);
+                  60 * std::min(job.print.paths.travel_speed, 20.0), over->x(), over->y(),
+                  60 * job.print.paths.travel_speed);
     entry = buf;
-    shell_opt.start = Vec3(enter_over->x(), enter_over->y(), top);
+    shell_opt.start = Vec3(over->x(), over->y(), top);
   }
   shell_opt.start_retracted = core.retracted;
   auto shell = map_foreign_gcode(shell_text, path_field, job.map_back, ctx, shell_opt);

@@ -2,7 +2,6 @@
 // (PrusaSlicer): two runs of it, stitched into one program.
 #pragma once
 
-#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -42,15 +41,15 @@ Expected<ForeignGcode> map_shell_core(std::string_view core_text, const layers::
                                       std::vector<char> others = {});
 
 /// Inputs: the mapped core, the shell's G-code (its layers planes of ShellField(plan, base)),
-/// the note written where the shell begins, and optionally where to enter the shell from
-/// above (XY, mm: other objects printed with the core may stand higher than the shell where
-/// the core ended; the nozzle then rises to the highest point printed + travel_lift and goes
-/// there first). Output: one program: the core's start and layers, the shell's layers mapped
-/// onto the shell (entered from where the core ended, its retraction given back; its fan as
-/// the shell's program had it when its print began), the core's end.
+/// the note written where the shell begins. Output: one program: the core's start and layers,
+/// the shell's layers mapped onto the shell, its fan as the shell's program had it when its
+/// print began, the core's end. The shell is entered from above: the nozzle rises to the
+/// highest point printed + travel_lift where the core ended (on a support column beside the
+/// part, or on another object of the plate taller than the shell, a layer change mapped
+/// there would have gone down into it) and travels there to over the shell's first move;
+/// the core's retraction is given back with the shell's first.
 Expected<EngineShell> join_shell(ForeignGcode core, std::string_view shell_text,
                                  const layers::ShellPlan& plan, double base, const EngineRoute& job,
-                                 const std::string& note, const Context& ctx,
-                                 const std::optional<Vec2>& enter_over = std::nullopt);
+                                 const std::string& note, const Context& ctx);
 
 }  // namespace nonplanar

@@ -336,8 +336,7 @@ Expected<EngineShell> map_shell_gcode(ShellSplit& sp, const Vec2& moved, const S
   if (!core) return core.error();
   std::string().swap(sp.core);
   return join_shell(std::move(*core), sp.shell, shell, shell.core.back() + shell.t, route,
-                    "the shell's curved layers, from the slicer's layers above the core", ctx,
-                    sp.enter_over);
+                    "the shell's curved layers, from the slicer's layers above the core", ctx);
 }
 
 // Whether our mark heads our header, which the time estimate's first M73 lines may precede (a
@@ -439,7 +438,7 @@ Expected<PostProcessed> post_process_gcode(std::string_view gcode, const PrintPl
   if (!ok) return ok.error();
   // A shell prints after everything else on the plate: an object near it standing higher
   // is in the head's way.
-  if (!*ok && checked->split && checked->split->enter_over) {
+  if (!*ok && checked->split && checked->split->shares_plate) {
     std::snprintf(buf, sizeof buf, "%.0f", job.check.toolhead.reach());
     return Error{Status::internal_error,
                  "safety check: " + breach + "; the shell prints after the plate's other " +

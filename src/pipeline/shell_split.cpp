@@ -62,6 +62,40 @@ Expected<std::size_t> plate_layer(const GcodeProgram& prog, const LayerUse& use,
   return above[0];
 }
 
+// The lines of the supports in the part's layers above `from` (mm): their moves, and the
+// travels and retractions that lead to them (the slicer writes a support's ;TYPE: after the
+// travel to it, and the splice must not go there). Their length in *mm; whether the part
+// extrudes anything else there in *printed.
+std::vector<char> support_lines(const GcodeProgram& prog, const std::vector<char>& owner,
+                                double from, double* mm, bool* printed) {
+  std::vector<char> support(prog.lines.size(), 0);
+  std::vector<std::size_t> leading;  // moves since the last extrusion
+  for (const GcodeMove& m : prog.moves) {
+    if (m.layer < 0 || prog.layer_z[static_cast<std::size_t>(m.layer)] <= from || m.line <= 0 ||
+        owner[static_cast<std::size_t>(m.line - 1)] == kOthers)
+      continue;
+    const auto line = static_cast<std::size_t>(m.line - 1);
+    const bool of_support = role_from_name(m.type) == ExtrusionRole::support;
+    if (!m.extruding()) {
+      if (!m.has_xy && !m.has_e) continue;  // a layer change's Z
+      if (of_support)
+        support[line] = 1;
+      else
+        leading.push_back(line);
+      continue;
+    }
+    if (of_support) {
+      *mm += (m.to - m.from).norm();
+      support[line] = 1;
+      for (const std::size_t l : leading) support[l] = 1;
+    } else {
+      *printed = true;
+    }
+    leading.clear();
+  }
+  return support;
+}
+
 }  // namespace
 
 Expected<ShellSplit> shell_split(const GcodeProgram& prog, std::string_view gcode,
@@ -81,16 +115,8 @@ Expected<ShellSplit> shell_split(const GcodeProgram& prog, std::string_view gcod
   // under the slab in the core's layers stand where the shell goes, and the core's cut takes
   // them (map_shell_core).
   bool printed = false;
-  std::vector<char> support(prog.lines.size(), 0);
-  for (const GcodeMove& m : prog.moves) {
-    if (m.layer < 0 || prog.layer_z[static_cast<std::size_t>(m.layer)] <= slab_from ||
-        m.line <= 0 || owner[static_cast<std::size_t>(m.line - 1)] == kOthers)
-      continue;
-    const bool of_support = role_from_name(m.type) == ExtrusionRole::support;
-    support[static_cast<std::size_t>(m.line - 1)] = of_support && (m.has_xy || m.has_e);
-    if (of_support && m.extruding()) out.supports_left_out += (m.to - m.from).norm();
-    if (!of_support && m.extruding()) printed = true;
-  }
+  const std::vector<char> support =
+      support_lines(prog, owner, slab_from, &out.supports_left_out, &printed);
   if (!printed) return refuse_split("the shell's layers hold no extrusion of the part");
 
   // Which lines each program keeps: the core everything up to z_s, and above it the other
@@ -122,11 +148,7 @@ Expected<ShellSplit> shell_split(const GcodeProgram& prog, std::string_view gcod
   if (!shell_lines.problem().empty()) return refuse_split(shell_lines.problem());
   out.core.append(end);
   out.shell.append(end);
-  const bool others = std::find(owner.begin(), owner.end(), kOthers) != owner.end();
-  for (std::size_t i = prog.print_begin; i < prog.print_end && others && !out.enter_over; ++i)
-    if (slab[i] && prog.lines[i].kind == GcodeLine::Kind::move &&
-        prog.moves[static_cast<std::size_t>(prog.lines[i].move)].has_xy)
-      out.enter_over = prog.moves[static_cast<std::size_t>(prog.lines[i].move)].to.head<2>();
+  out.shares_plate = std::find(owner.begin(), owner.end(), kOthers) != owner.end();
   out.others.resize(marks.size());
   for (std::size_t i = 0; i < marks.size(); ++i) out.others[i] = marks[i] == 2;
   return out;

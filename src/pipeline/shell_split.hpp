@@ -4,7 +4,6 @@
 // the plate print with the core, as the slicer wrote them.
 #pragma once
 
-#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -29,9 +28,8 @@ struct ShellSplit {
   /// The file's start G-code, then the layers of the shell (the planned part's lines and
   /// the layer changes), then its end G-code; a program of its own.
   std::string shell;
-  /// Where the shell's first move goes (XY, mm) when the plate holds other objects: the
-  /// shell is entered from over them (join_shell). None for the part alone.
-  std::optional<Vec2> enter_over;
+  /// Whether other objects share the plate (they print with the core, the shell after them).
+  bool shares_plate = false;
   /// Support extrusions the slicer put in the shell's layers (under the slab, which stands
   /// above the part in the 3MF), left out as the engine route's slab run has none; mm of them.
   double supports_left_out = 0;

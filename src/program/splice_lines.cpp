@@ -12,6 +12,8 @@ namespace {
 constexpr double kSameE = 1e-6;    ///< mm of filament
 constexpr double kSameAt = 1e-4;   ///< mm: the file writes 3 decimals
 constexpr double kSameFeed = 0.5;  ///< mm/min
+constexpr double kHopOver = 2.0;   ///< mm: a travel it adds longer than this is retracted around
+constexpr double kTravelF = 7800;  ///< mm/min: its travels' feed rate (PrusaSlicer's default)
 
 bool fan_line(std::string_view raw) {
   return raw.rfind("M106", 0) == 0 || raw.rfind("M107", 0) == 0;
@@ -20,7 +22,7 @@ bool fan_line(std::string_view raw) {
 }  // namespace
 
 LineSplicer::LineSplicer(const GcodeProgram& prog) : prog_(prog) {
-  if (prog.retraction.f != kNoValue && prog.retraction.f > 0) retract_f_ = prog.retraction.f;
+  if (prog.retraction.f > 0) retract_f_ = prog.retraction.f;  // (false for kNoValue, a NaN)
 }
 
 void LineSplicer::follow(const GcodeLine& l, State& s) const {
@@ -87,16 +89,30 @@ void LineSplicer::reconcile(const GcodeMove& m, std::string& out, std::vector<ch
   };
   if (push < 0) move_e();  // pulled back before the travel
   const Vec3& from = m.from;
-  if (m.extruding() && (t.at.head<2>() - from.head<2>()).norm() > kSameAt) {
-    add(out, marks, "G1 X%.3f Y%.3f Z%.3f", from.x(), from.y(), from.z());
-    t.at = from;
+  const double travel = (t.at.head<2>() - from.head<2>()).norm();
+  if (m.extruding() && travel > kSameAt) {
+    // Pulled back around it as the file's own travels are (the dropped lines held them).
+    const double len = prog_.retraction.length;
+    const bool hop = push == 0 && len > 0 && travel > kHopOver;
+    if (hop) {
+      add(out, marks, "G1 E%.5f F%.0f", t.relative_e ? -len : t.e - len, retract_f_);
+      if (!t.relative_e) t.e -= len;
+    }
+    add(out, marks, "G1 X%.3f Y%.3f Z%.3f F%.0f", from.x(), from.y(), from.z(), kTravelF);
+    t.at = from, t.feed = kTravelF;
+    if (hop) {
+      const double back = prog_.retraction.back_f > 0 ? prog_.retraction.back_f : retract_f_;
+      add(out, marks, "G1 E%.5f F%.0f", t.relative_e ? len : t.e + len, back);
+      if (!t.relative_e) t.e += len;
+      t.feed = back;
+    }
   } else if (m.has_xy && !m.has_z && std::abs(t.at.z() - from.z()) > kSameAt) {
     add(out, marks, "G1 Z%.3f", from.z());
     t.at.z() = from.z();
   }
   if (push > 0) move_e();  // given back where the file's extrusion begins
-  if (m.f == kNoValue && m.feed != kNoValue &&
-      (t.feed == kNoValue || std::abs(t.feed - m.feed) > kSameFeed)) {
+  if (std::isnan(m.f) && !std::isnan(m.feed) &&
+      (std::isnan(t.feed) || std::abs(t.feed - m.feed) > kSameFeed)) {
     add(out, marks, "G1 F%.0f", m.feed);
     t.feed = m.feed;
   }

@@ -6,10 +6,11 @@
 // much filament is pulled back), where the head is, the feed rate, the E mode and the fan.
 // Before each kept move the spliced text is brought to the state the file had there: M82/M83,
 // G92 E, a retraction or its give-back (a retraction before a travel, the give-back after it),
-// a travel to where the file's head was (before an extrusion; its Z, before a travel that
-// writes none), the feed rate (before a move without F), the fan (before an extrusion). So a
-// kept extrusion lays what it laid in the file, where it laid it. A wipe that would retrace an
-// extrusion the text lacks pulls its filament back where the head is instead.
+// a travel to where the file's head was (before an extrusion, retracted around with the
+// file's own retraction when over 2 mm; its Z, before a travel that writes none), the feed rate
+// (before a move without F), the fan (before an extrusion). So a kept extrusion lays what it laid
+// in the file, where it laid it. A wipe that would retrace an extrusion the text lacks pulls its
+// filament back where the head is instead.
 #pragma once
 
 #include <cstddef>

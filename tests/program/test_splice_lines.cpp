@@ -194,5 +194,44 @@ TEST(LineSplicer, AnExtrusionAfterADroppedTravelStartsWhereTheFilesDid) {
   EXPECT_NE(s.problem().find("G91"), std::string::npos);
 }
 
+// A dropped travel with its retraction and feed rate (a support's, whose ;TYPE: it carries):
+// the splice travels retracted, gives the filament back, and restores the extrusion's feed.
+TEST(LineSplicer, ATravelItAddsIsRetractedAround) {
+  for (const bool relative : {false, true}) {
+    SCOPED_TRACE(relative ? "relative" : "absolute");
+    const std::string text = std::string(relative ? "M83\n" : "M82\n") +
+                             "G92 E0\nG1 X0 Y0 Z0.2 F7800\n;LAYER_CHANGE\n;Z:0.2\n"
+                             "G1 F1500\nG1 X10 Y0 E" +
+                             (relative ? "0.5" : "0.5") + "\nG1 E" + (relative ? "-0.8" : "-0.3") +
+                             " F2100\nG1 X30 Y20 F9000\nG1 E" + (relative ? "0.8" : "0.5") +
+                             " F1800\nG1 F1200\nG1 X40 Y20 E" + (relative ? "0.5" : "1.0") + "\n";
+    const GcodeProgram file = read_gcode_program(text);
+    ASSERT_TRUE(file.problems.empty());
+    EXPECT_NEAR(file.retraction.length, 0.8, 1e-9);
+    std::vector<char> keep(file.lines.size(), 1);
+    for (std::size_t i = 7; i <= 10; ++i) keep[i] = 0;  // retract, travel, give back, F
+    std::string out;
+    LineSplicer s(file);
+    s.append(0, file.lines.size(), keep, out);
+    const GcodeProgram spliced = read_gcode_program(out);
+    const auto want = extrusions(file), got = extrusions(spliced);
+    ASSERT_EQ(got.size(), 2u) << out;
+    EXPECT_LT((got[1].from - want[1].from).norm(), 1e-9) << out;
+    EXPECT_NEAR(got[1].de, want[1].de, 1e-9) << out;
+    EXPECT_NEAR(got[1].feed, 1200, 1e-9) << out;
+    EXPECT_NEAR(got[1].retracted, 0, 1e-9) << out;
+    double retracted = 0;
+    int travels = 0;
+    for (const GcodeMove& m : spliced.moves) {
+      if (m.has_e && !m.extruding()) retracted -= m.de;
+      if (m.has_xy && !m.has_e && (m.to - m.from).head<2>().norm() > 2) {
+        ++travels;
+        EXPECT_NEAR(retracted, 0.8, 1e-9) << out;  // the travel goes pulled back
+      }
+    }
+    EXPECT_EQ(travels, 1) << out;
+  }
+}
+
 }  // namespace
 }  // namespace nonplanar::program
