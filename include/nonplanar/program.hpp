@@ -235,6 +235,7 @@ struct PrintMove {
   Vec3 from{0, 0, 0}, to{0, 0, 0};
   double filament = 0;     ///< mm of filament pushed (negative: retraction)
   bool extruding = false;  ///< filament > 0 and the nozzle moved in XY
+  bool wipe = false;       ///< between ;WIPE_START and ;WIPE_END
   std::string_view type;   ///< the ;TYPE: in force ("" before any); views the text read
   int layer = -1;          ///< ;LAYER_CHANGE count − 1
   double width = 0.45;     ///< ;WIDTH: in force

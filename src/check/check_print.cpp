@@ -366,6 +366,9 @@ Expected<Samples> sample_extrusions(const MoveReplay& moves) {
 }
 
 // Collisions, in print order, among the points `looked_at` accepts (null: all).
+constexpr double kTravelStep = 0.5;  ///< mm between the points of a travel looked at
+constexpr double kUnderBed = 0.01;   ///< mm: a move lower than this under z = 0 hits the bed
+
 Expected<CollisionFigures> search_collisions(const MoveReplay& moves, const Samples& s,
                                              const CheckParams& cp,
                                              const std::function<bool(const Vec3&)>& looked_at,
@@ -378,21 +381,32 @@ Expected<CollisionFigures> search_collisions(const MoveReplay& moves, const Samp
   Deposit dep(s.lo - Vec2(margin, margin), s.hi + Vec2(margin, margin), 0.2);
   std::size_t mi = 0;
   bool cancelled = false;
+  auto hit = [&](const Vec3& p, int line) {
+    if (f.collisions == 0) f.first_collision = p, f.first_collision_line = line;
+    // Spread out (1 mm apart at least): one long collision must not fill the list.
+    if (f.points.size() < 4096 && (f.points.empty() || (f.points.back() - p).norm() > 1.0))
+      f.points.push_back(p);
+    ++f.collisions;
+  };
   moves([&](const PrintMove& m) {
     if (cancelled || ((mi++ & 0xffff) == 0 && (cancelled = ctx.cancelled()))) return;
-    if (!m.extruding || m.layer < 0) return;
+    if (m.layer < 0) return;
     const double len = (m.to - m.from).norm();
-    const int n = std::max(1, static_cast<int>(std::ceil(len / 0.2)));
+    // A travel goes where a head can: above the bed, and into no material printed before it
+    // deeper than an extrusion may (the shell's first layer change, mapped where a core ended
+    // on a support column, once sent the nozzle to z = -0.3 there). It lays none. A wipe
+    // retraces the extrusion before it, on that extrusion's layer, though the slicer writes
+    // it after the next layer change: only the bed is its business here.
+    const double step = m.extruding ? 0.2 : kTravelStep;
+    if (!m.extruding && len < 1e-9) return;
+    const int n = std::max(1, static_cast<int>(std::ceil(len / step)));
     for (int k = 1; k <= n; ++k) {
       const Vec3 p = m.from + (m.to - m.from) * (static_cast<double>(k) / n);
-      if ((!looked_at || looked_at(p)) && dep.collides(p, m.layer, head, 0.5 * cp.layer_height)) {
-        if (f.collisions == 0) f.first_collision = p, f.first_collision_line = m.line;
-        // Spread out (1 mm apart at least): one long collision must not fill the list.
-        if (f.points.size() < 4096 && (f.points.empty() || (f.points.back() - p).norm() > 1.0))
-          f.points.push_back(p);
-        ++f.collisions;
-      }
-      dep.put(p, m.layer);
+      if ((!m.extruding && p.z() < -kUnderBed) ||
+          ((m.extruding || !m.wipe) && (!looked_at || looked_at(p)) &&
+           dep.collides(p, m.layer, head, 0.5 * cp.layer_height)))
+        hit(p, m.line);
+      if (m.extruding) dep.put(p, m.layer);
     }
   });
   if (cancelled) return Error{Status::cancelled, "cancelled"};

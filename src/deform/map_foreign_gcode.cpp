@@ -16,12 +16,14 @@
 #include <cmath>
 #include <cstdio>
 #include <optional>
+#include <utility>
 
 #include "deform/map_gcode_layer.hpp"
 #include "deform/map_segment.hpp"
 #include "nonplanar/deform.hpp"
 #include "program/gcode_text.hpp"
 #include "program/layer_passes.hpp"
+#include "program/printed_top.hpp"
 
 namespace nonplanar {
 namespace {
@@ -32,11 +34,13 @@ using program::LayerWork;
 
 // What carries over from one layer's writing to the next.
 struct Writing {
+  Writing(GcodeText text, program::PrintedTop top) : w(std::move(text)), printed(std::move(top)) {}
   GcodeText w;
-  ProgramLayer layer{};  ///< the layer being built (then written into w)
-  Vec3 at{0, 0, 0};      ///< the nozzle, mapped
-  double pending = 0;    ///< filament owed from before the print, given back at the first E
-  double retracted = 0;  ///< filament the print's own retractions leave pulled back
+  ProgramLayer layer{};         ///< the layer being built (then written into w)
+  Vec3 at{0, 0, 0};             ///< the nozzle, mapped
+  double pending = 0;           ///< filament owed from before the print, given back at the first E
+  double retracted = 0;         ///< filament the print's own retractions leave pulled back
+  program::PrintedTop printed;  ///< what the travels must clear (mapped extrusions so far)
 };
 
 // An extrusion or wipe (a travel step, retracting as it goes), one G1 per mapped piece; an
@@ -70,6 +74,7 @@ void add_pieces(const GcodeMove& m, const ExtrusionPath& p, LayerToolpaths& L, l
       const double hq = 0.5 * (p.height[q] + p.height[q - 1]);
       de = lp > 0 ? m.de * (seg / lp) * (hq / m.height) : 0;
       ExtrusionPath& g = L.paths[static_cast<std::size_t>(run)];
+      s.printed.lay(p.points[q - 1], p.points[q]);
       g.points.push_back(p.points[q]);
       g.height.push_back(p.height[q]);
       h_sum += p.height[q], ++h_n;
@@ -99,13 +104,23 @@ void add_travel(const GcodeMove& m, const LayerField& field, const MapBackParams
   const Vec3 planar_to = m.has_xy ? m.to : Vec3(s.at.x(), s.at.y(), m.to.z());
   const Mapped target = keep ? Mapped{planar_to, m.height} : map_point(field, planar_to, m.height);
   const Vec3 to = target.p;
-  const bool curved =
+  bool curved =
       target.p.z() != m.to.z() || !field.planar_at(m.from.x(), m.from.y()) ||
       !field.planar_along(m.from.head<2>(), m.to.head<2>(), field.t_of_zeta(m.to.z() - m.height),
                           field.t_of_zeta(m.to.z()));
+  // Over what was printed before along the way where it stands higher than this layer (a
+  // planar object's layer after a curved layer of the planned part that rose above it: the
+  // dome beside a cube was crossed at the cube's height + 0.3 mm, 0.4 mm under its top).
+  double top = L.max_z;
+  const double ends = std::max({top, s.at.z(), to.z()});
+  if (m.has_xy && s.printed.highest() > ends) {
+    const double under =
+        s.printed.over(s.at.head<2>(), to.head<2>(), params.tip_radius + program::kTravelCorridor);
+    if (under > ends) top = under, curved = true;
+  }
   const double de = m.has_e ? m.de + s.pending : kNoValue;
   if (m.has_e) s.retracted -= m.de, s.pending = 0;
-  const double lift = curved && m.has_xy ? travel_height(s.at, to, L.max_z, L.max_slope,
+  const double lift = curved && m.has_xy ? travel_height(s.at, to, top, L.max_slope,
                                                          params.tip_radius, params.travel_lift)
                                          : kNoValue;
   if (!std::isnan(lift)) {
@@ -115,6 +130,15 @@ void add_travel(const GcodeMove& m, const LayerField& field, const MapBackParams
     s.layer.move_from(s.at, to, de, m.f);
   }
   s.at = to;
+}
+
+// Cells over where the print's moves go, with room for the mapping's few millimetres.
+program::PrintedTop printed_top_over(const GcodeProgram& prog) {
+  BoundingBox b;
+  for (const GcodeMove& m : prog.moves)
+    if (m.layer >= 0) b.extend(m.from), b.extend(m.to);
+  if (b.empty()) return {};
+  return program::PrintedTop(b.min.head<2>() - Vec2(5, 5), b.max.head<2>() + Vec2(5, 5));
 }
 
 // One mapped layer as steps (s.layer); ;Z: becomes its highest point and ;HEIGHT: its mean
@@ -249,7 +273,7 @@ Expected<ForeignGcode> map_foreign_gcode(std::string_view text, const LayerField
 
   ForeignGcode out;
   out.layers.resize(prog.layer_height.size());
-  Writing s{GcodeText(prog.at_print.relative_e, prog.at_print.e)};
+  Writing s(GcodeText(prog.at_print.relative_e, prog.at_print.e), printed_top_over(prog));
   std::vector<ExtrusionPath> mapped;  // as much room as the moves (the passes add to both)
   mapped.reserve(prog.moves.capacity());
   mapped.resize(prog.moves.size());

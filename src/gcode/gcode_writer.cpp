@@ -17,6 +17,7 @@
 #include "nonplanar/gcode.hpp"
 #include "nonplanar/macros.hpp"
 #include "program/gcode_text.hpp"
+#include "program/printed_top.hpp"
 
 namespace nonplanar {
 
@@ -206,7 +207,7 @@ std::string fan_line(int percent, GcodeFlavor flavor) {
 class LayerBuilder {
  public:
   explicit LayerBuilder(const PrintConfig& c)
-      : c_(c), g_(c.gcode), tip_radius_(c.toolhead.tip_radius) {}
+      : c_(c), g_(c.gcode), tip_radius_(c.toolhead.tip_radius), printed_(c.bed_min, c.bed_max) {}
   /// The first point off the bed: the program is refused.
   std::optional<Error> fault;
   const char* what = "the print";  ///< what is being built, for the fault's message
@@ -232,6 +233,14 @@ class LayerBuilder {
   void travel(const Vec3& p, double speed, bool curved, double safe_z, double slope) {
     check_on_bed(p, what);  // a travel to the skirt is the skirt's problem
     const double f = feed(speed);
+    // Over what was laid before along the way, where that stands higher than this layer (a
+    // shell's piece printed after core layers that rise above it: the bunny's went through
+    // them at the piece's own height + 0.3 mm).
+    if (have_pos_ && printed_.highest() > std::max({safe_z, p.z(), pos_.z()})) {
+      const double under =
+          printed_.over(pos_.head<2>(), p.head<2>(), tip_radius_ + program::kTravelCorridor);
+      if (under > std::max({safe_z, p.z(), pos_.z()})) curved = true, safe_z = under;
+    }
     if (curved && have_pos_) {
       const double d = (p.head<2>() - pos_.head<2>()).norm();
       if (d < 1e-6 && std::abs(p.z() - pos_.z()) < 1e-6) return;
@@ -276,6 +285,7 @@ class LayerBuilder {
     m.to = p, m.xy = true, m.z = std::abs(p.z() - pos_.z()) > 1e-9, m.de = de, m.f = feed(speed);
     m.height = height;
     layer.move(m);
+    printed_.lay(pos_, p);
     pos_ = p;
   }
 
@@ -309,6 +319,7 @@ class LayerBuilder {
   const PrintConfig& c_;
   const GcodeParams& g_;
   double tip_radius_;  ///< what a short hop must clear (travel_height)
+  program::PrintedTop printed_;
   Vec3 pos_ = Vec3::Zero();
   bool have_pos_ = false, retracted_ = false;
   ExtrusionRole role_ = ExtrusionRole::perimeter;

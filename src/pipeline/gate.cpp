@@ -189,7 +189,7 @@ Expected<bool> gate(SliceResult& r, const SliceJob& job, const layers::BandedFie
   r.collisions = figures->collisions;
   if (figures->collisions > 0)
     for (const Vec3& p : figures->points)
-      if (!violation(p, "an extrusion would hit earlier layers")) return false;
+      if (!violation(p, "the nozzle would hit earlier layers")) return false;
   return true;
 }
 

@@ -313,7 +313,7 @@ void Reader::move(core::Tokenizer& tok, GcodeLine& item, bool in_print) {
 
 PrintMove print_move(const GcodeMove& g) {
   PrintMove m;
-  m.from = g.from, m.to = g.to, m.filament = g.de, m.extruding = g.extruding();
+  m.from = g.from, m.to = g.to, m.filament = g.de, m.extruding = g.extruding(), m.wipe = g.wipe;
   m.type = g.type, m.layer = g.layer, m.width = g.width, m.line = g.line;
   return m;
 }

@@ -80,6 +80,46 @@ TEST(CheckPrint, NozzleBelowEarlierMaterialCollides) {
   EXPECT_EQ(f->collisions, 0u);
 }
 
+// A travel goes where a head can: not into material printed before it (a layer change mapped
+// where a core ended on a support column once sent the nozzle down through it), not under the
+// bed; over the material, or beside a ridge the cone clears, is no collision.
+TEST(CheckPrint, ATravelIntoEarlierMaterialOrUnderTheBedCollides) {
+  std::vector<PrintMove> moves;
+  raster(moves, 0, 10, 1, 2.0);  // a ridge 2 mm high
+  PrintMove t;
+  t.from = {5, 0.5, 3}, t.to = {5, 0.5, 0.4};  // straight down into it
+  t.layer = 1, t.line = 7;
+  moves.push_back(t);
+  auto f = check_print(moves, nullptr, {}, {});
+  ASSERT_TRUE(f);
+  EXPECT_GE(f->collisions, 3u);  // 0.5 mm apart, from 2 mm down
+  EXPECT_EQ(f->first_collision_line, 7);
+  EXPECT_LT(f->first_collision.z(), 2.0);
+  moves.back().to = {5, 0.5, 2.2};  // down onto it
+  f = check_print(moves, nullptr, {}, {});
+  ASSERT_TRUE(f);
+  EXPECT_EQ(f->collisions, 0u);
+  moves.back().from = {-20, 8, 2.2}, moves.back().to = {30, 8, 2.2};  // across, 8 mm off
+  f = check_print(moves, nullptr, {}, {});
+  ASSERT_TRUE(f);
+  EXPECT_EQ(f->collisions, 0u);
+  moves.back().from = {30, 30, 1}, moves.back().to = {30, 30, -0.3};  // under the bed
+  f = check_print(moves, nullptr, {}, {});
+  ASSERT_TRUE(f);
+  EXPECT_EQ(f->collisions, 1u);
+  EXPECT_NEAR(f->first_collision.z(), -0.3, 1e-9);
+  // A wipe retraces its extrusion's layer though written after the next layer change: only
+  // the bed is its business.
+  moves.back().wipe = true;
+  f = check_print(moves, nullptr, {}, {});
+  ASSERT_TRUE(f);
+  EXPECT_EQ(f->collisions, 1u);
+  moves.back().from = {5, 0.5, 3}, moves.back().to = {5, 0.5, 0.4};
+  f = check_print(moves, nullptr, {}, {});
+  ASSERT_TRUE(f);
+  EXPECT_EQ(f->collisions, 0u);
+}
+
 TEST(CheckPrint, CollisionSearchAloneCountsTheSame) {
   std::vector<PrintMove> moves;
   raster(moves, 0, 10, 3, 1.5);

@@ -4,7 +4,9 @@
 #include <cmath>
 
 #include "core/column_caster.hpp"
+#include "nonplanar/check.hpp"
 #include "nonplanar/gcode.hpp"
+#include "nonplanar/toolhead.hpp"
 #include "support/files.hpp"
 #include "support/gcode_reader.hpp"
 #include "support/solids.hpp"
@@ -40,6 +42,39 @@ double filament_volume(const test::Program& prog, double d, bool skip_skirt = tr
   for (const auto& m : prog.moves)
     if (m.layer >= 0 && !m.travel && !(skip_skirt && m.type == "Skirt/Brim")) e += m.de;
   return e * M_PI * 0.25 * d * d;
+}
+
+// A layer printed after a higher one (a shell's piece after core layers that rise above it)
+// travels over what was laid before, not through it at its own height + the lift: the
+// bunny's shells had gone through their core that way, which the collision search now sees.
+TEST(PlanarPrint, ATravelClearsHigherMaterialLaidBefore) {
+  PrintConfig c;
+  auto line = [](const Vec3& a, const Vec3& b, double h) {
+    ExtrusionPath p;
+    p.points = {a, b}, p.height = {h, h}, p.role = ExtrusionRole::perimeter;
+    return p;
+  };
+  std::vector<LayerToolpaths> layers(2);
+  for (int k = 0; k < 25; ++k) {  // a wall 5 mm high across the way, printed first
+    LayerToolpaths& w = layers[0];
+    const double z = 0.2 * (k + 1);
+    w.paths.push_back(line({110, 100, z}, {110, 120, z}, 0.2));
+    w.z = w.max_z = z;
+  }
+  layers[0].nonplanar = true;
+  LayerToolpaths& low = layers[1];  // then two lines at z = 1, one each side of it
+  low.paths = {line({100, 110, 1}, {102, 110, 1}, 0.2), line({118, 110, 1}, {120, 110, 1}, 0.2)};
+  low.z = low.max_z = 1, low.nonplanar = true;
+  auto text = make_gcode(layers, c, {"test"}, {});
+  ASSERT_TRUE(text) << text.error().message;
+  auto moves = read_gcode_moves(*text);
+  ASSERT_TRUE(moves);
+  double over = 0;
+  for (const PrintMove& m : *moves)
+    if (!m.extruding && m.layer == 1 && (m.from.x() - 110) * (m.to.x() - 110) < 0)
+      over = std::max(over, m.from.z());
+  EXPECT_GE(over, 5.0 + travel_lift(c.gcode.retract_lift) - 1e-6);
+  EXPECT_EQ(find_collisions(*moves, check_params(c, 30), nullptr, {})->collisions, 0u);
 }
 
 TEST(PlanarPrint, CubeAtFullInfillExtrudesItsVolume) {

@@ -110,7 +110,7 @@ TEST(Gate, FindsACollisionWithAShellPiecePrintedEarlierWithoutBands) {
   };
   std::string what;
   EXPECT_FALSE(run(115, &what));  // under the ramp's top: material 4 mm over the nozzle
-  EXPECT_EQ(what, "an extrusion would hit earlier layers");
+  EXPECT_EQ(what, "the nozzle would hit earlier layers");
   what.clear();
   EXPECT_TRUE(run(160, &what)) << what;  // 40 mm away, beyond the heater block
 }

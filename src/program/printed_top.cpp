@@ -1,0 +1,64 @@
+// PrintedTop (printed_top.hpp): the highest material laid so far, per 1 mm cell.
+#include "program/printed_top.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace nonplanar::program {
+
+namespace {
+constexpr double kCell = 1.0;        ///< mm
+constexpr int kMostCells = 1 << 22;  ///< a 2 m bed at 1 mm; past it the cells grow coarser
+}  // namespace
+
+PrintedTop::PrintedTop(const Vec2& lo, const Vec2& hi) : lo_(lo) {
+  const Vec2 size = (hi - lo).cwiseMax(Vec2(0, 0));
+  if (!size.allFinite()) return;
+  nx_ = static_cast<int>(std::min(size.x() / kCell, 4096.0)) + 1;
+  ny_ = static_cast<int>(std::min(size.y() / kCell, 4096.0)) + 1;
+  if (static_cast<long>(nx_) * ny_ > kMostCells) nx_ = ny_ = 0;
+  top_.assign(static_cast<std::size_t>(nx_) * static_cast<std::size_t>(ny_),
+              -std::numeric_limits<float>::infinity());
+}
+
+void PrintedTop::lay(const Vec3& a, const Vec3& b) {
+  const int n = std::max(1, static_cast<int>(std::ceil((b - a).head<2>().norm() / (0.5 * kCell))));
+  for (int k = 0; k <= n; ++k) lay(a + (b - a) * (static_cast<double>(k) / n));
+}
+
+void PrintedTop::lay(const Vec3& p) {
+  highest_ = std::max(highest_, p.z());
+  const double fx = std::floor((p.x() - lo_.x()) / kCell),
+               fy = std::floor((p.y() - lo_.y()) / kCell);
+  if (!(fx >= 0 && fy >= 0 && fx < nx_ && fy < ny_)) return;
+  float& t = top_[static_cast<std::size_t>(fx) * static_cast<std::size_t>(ny_) +
+                  static_cast<std::size_t>(fy)];
+  t = std::max(t, static_cast<float>(p.z()));
+}
+
+double PrintedTop::over(const Vec2& a, const Vec2& b, double r) const {
+  double best = -std::numeric_limits<double>::infinity();
+  if (top_.empty()) return best;
+  // The cells within r of the segment: those whose centre is within r + a cell's half
+  // diagonal of it, in the segment's box grown by r.
+  const Vec2 lo = a.cwiseMin(b) - Vec2(r, r), hi = a.cwiseMax(b) + Vec2(r, r);
+  const int i0 = std::max(0, static_cast<int>(std::floor((lo.x() - lo_.x()) / kCell)));
+  const int i1 = std::min(nx_ - 1, static_cast<int>(std::floor((hi.x() - lo_.x()) / kCell)));
+  const int j0 = std::max(0, static_cast<int>(std::floor((lo.y() - lo_.y()) / kCell)));
+  const int j1 = std::min(ny_ - 1, static_cast<int>(std::floor((hi.y() - lo_.y()) / kCell)));
+  const Vec2 ab = b - a;
+  const double len2 = ab.squaredNorm(), reach = r + 0.7072 * kCell;
+  for (int i = i0; i <= i1; ++i)
+    for (int j = j0; j <= j1; ++j) {
+      const float t = top_[static_cast<std::size_t>(i) * static_cast<std::size_t>(ny_) +
+                           static_cast<std::size_t>(j)];
+      if (t <= best) continue;
+      const Vec2 c = lo_ + Vec2((i + 0.5) * kCell, (j + 0.5) * kCell);
+      const double s = len2 > 0 ? std::clamp((c - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
+      if ((a + s * ab - c).norm() <= reach) best = t;
+    }
+  return best;
+}
+
+}  // namespace nonplanar::program

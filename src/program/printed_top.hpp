@@ -1,0 +1,38 @@
+// The highest material laid so far over each 1 mm cell of the bed, as a program is written in
+// print order: what a travel must clear where layers are printed out of order (a shell's
+// pieces after core layers standing higher than they do; a planar object's layer after a
+// curved layer of another that rose above it).
+#pragma once
+
+#include <limits>
+#include <vector>
+
+#include "nonplanar/mesh.hpp"
+
+namespace nonplanar::program {
+
+/// mm beside a travel's path, past the nozzle tip's radius, that it must clear.
+inline constexpr double kTravelCorridor = 1.0;
+
+class PrintedTop {
+ public:
+  PrintedTop() = default;  ///< no cells: over() finds nothing
+  /// Cells over [lo, hi] (mm, XY), 1 mm square; points off it are not kept.
+  PrintedTop(const Vec2& lo, const Vec2& hi);
+  /// A bead laid from a to b (the nozzle's tip, mm): every cell it crosses.
+  void lay(const Vec3& a, const Vec3& b);
+  /// The highest material laid within `r` mm of the segment a–b seen from above (its cells,
+  /// grown by r); -inf when none.
+  double over(const Vec2& a, const Vec2& b, double r) const;
+  /// The highest material laid anywhere (-inf: none).
+  double highest() const { return highest_; }
+
+ private:
+  void lay(const Vec3& p);
+  Vec2 lo_;
+  double highest_ = -std::numeric_limits<double>::infinity();
+  int nx_ = 0, ny_ = 0;
+  std::vector<float> top_;  ///< nx × ny, -inf where nothing is laid
+};
+
+}  // namespace nonplanar::program
