@@ -128,7 +128,7 @@ void LineSplicer::append(std::size_t begin, std::size_t end, const std::vector<c
   for (; next_ < begin && next_ < prog_.lines.size(); ++next_) follow(prog_.lines[next_], file_);
   for (std::size_t i = std::max(begin, next_); i < end && i < prog_.lines.size(); ++i) {
     const GcodeLine& l = prog_.lines[i];
-    if (l.kind == GcodeLine::Kind::xyz_relative && problem_.empty())
+    if (l.kind == GcodeLine::Kind::xyz_relative && prog_.in_print(i) && problem_.empty())
       problem_ = "line " + std::to_string(i + 1) +
                  ": relative moves (G91), under which the moves added between kept lines "
                  "would go astray";

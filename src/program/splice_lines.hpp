@@ -36,8 +36,9 @@ class LineSplicer {
   void append(std::size_t begin, std::size_t end, const std::vector<char>& keep, std::string& out,
               std::vector<char>* marks = nullptr);
 
-  /// A refusal found on the way (a G91 among the lines followed, under which the travels it
-  /// adds would go wrong); empty when none.
+  /// A refusal found on the way (a G91 among the print's lines followed, under which the
+  /// travels it adds would go wrong; the start and end G-code's own are theirs); empty when
+  /// none.
   const std::string& problem() const { return problem_; }
 
  private:
