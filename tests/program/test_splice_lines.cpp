@@ -193,8 +193,8 @@ TEST(LineSplicer, AnExtrusionAfterADroppedTravelStartsWhereTheFilesDid) {
   s.append(file.lines.size() - 1, file.lines.size(), keep, out);
   EXPECT_NE(s.problem().find("G91"), std::string::npos);
   // A start G-code's own G91 (a lift before homing) is its business.
-  const GcodeProgram start =
-      read_gcode_program("G91\nG1 Z5\nG90\n" + text.substr(0, text.find("G91")));
+  const std::string lifted = "G91\nG1 Z5\nG90\n" + text.substr(0, text.find("G91"));
+  const GcodeProgram start = read_gcode_program(lifted);  // (it views the text)
   std::string out2;
   LineSplicer s2(start);
   s2.append(0, start.lines.size(), std::vector<char>(start.lines.size(), 1), out2);
