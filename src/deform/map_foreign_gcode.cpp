@@ -112,11 +112,10 @@ void add_travel(const GcodeMove& m, const LayerField& field, const MapBackParams
   // planar object's layer after a curved layer of the planned part that rose above it: the
   // dome beside a cube was crossed at the cube's height + 0.3 mm, 0.4 mm under its top).
   double top = L.max_z;
-  const double ends = std::max({top, s.at.z(), to.z()});
-  if (m.has_xy && s.printed.highest() > ends) {
-    const double under =
-        s.printed.over(s.at.head<2>(), to.head<2>(), params.tip_radius + program::kTravelCorridor);
-    if (under > ends) top = under, curved = true;
+  if (m.has_xy) {
+    const double clear =
+        s.printed.to_clear(s.at, to, params.tip_radius + program::kTravelCorridor, top);
+    if (clear > std::max({top, s.at.z(), to.z()})) top = clear, curved = true;
   }
   const double de = m.has_e ? m.de + s.pending : kNoValue;
   if (m.has_e) s.retracted -= m.de, s.pending = 0;

@@ -236,10 +236,10 @@ class LayerBuilder {
     // Over what was laid before along the way, where that stands higher than this layer (a
     // shell's piece printed after core layers that rise above it: the bunny's went through
     // them at the piece's own height + 0.3 mm).
-    if (have_pos_ && printed_.highest() > std::max({safe_z, p.z(), pos_.z()})) {
-      const double under =
-          printed_.over(pos_.head<2>(), p.head<2>(), tip_radius_ + program::kTravelCorridor);
-      if (under > std::max({safe_z, p.z(), pos_.z()})) curved = true, safe_z = under;
+    if (have_pos_) {
+      const double clear =
+          printed_.to_clear(pos_, p, tip_radius_ + program::kTravelCorridor, safe_z);
+      if (clear > std::max({safe_z, p.z(), pos_.z()})) curved = true, safe_z = clear;
     }
     if (curved && have_pos_) {
       const double d = (p.head<2>() - pos_.head<2>()).norm();

@@ -232,17 +232,17 @@ std::vector<ConfigObject> config_objects(std::string_view zip) {
       const std::size_t end = s.find("</object>", at);
       const std::string_view obj = s.substr(at, end == std::string_view::npos ? 0 : end - at);
       const std::size_t key = obj.find("key=\"name\" value=\"");
-      const std::size_t v0 = key + 18;
-      const std::size_t v1 = key == std::string_view::npos ? v0 : obj.find('"', v0);
-      if (v1 == std::string_view::npos) continue;
       ConfigObject c;
+      if (key != std::string_view::npos) {
+        const std::size_t v0 = key + 18, v1 = obj.find('"', v0);
+        if (v1 == std::string_view::npos) continue;
+        c.name = std::string(obj.substr(v0, std::min<std::size_t>(v1 - v0, 200)));
+      }
       c.id = static_cast<DWORD>(std::strtoul(obj.data() + open.size(), nullptr, 10));
       const std::size_t n = obj.substr(0, obj.find('>')).find("instances_count=\"");
       if (n != std::string_view::npos)
         c.instances = static_cast<DWORD>(
             std::clamp(std::strtoul(obj.data() + n + 17, nullptr, 10), 1ul, 1000000ul));
-      if (key != std::string_view::npos)
-        c.name = std::string(obj.substr(v0, std::min<std::size_t>(v1 - v0, 200)));
       c.not_part = volumes_not_part(obj);
       out.push_back(std::move(c));
     }
@@ -274,10 +274,11 @@ class ItemNames {
     return p;
   }
   /// The object's triangles that are no part (ConfigObject::not_part); empty when none.
-  std::vector<std::pair<std::size_t, std::size_t>> not_part(
+  const std::vector<std::pair<std::size_t, std::size_t>>& not_part(
       NMR::PLib3MFModelObjectResource* obj) const {
+    static const std::vector<std::pair<std::size_t, std::size_t>> kNone;
     const ConfigObject* c = config_of(obj);
-    return c ? c->not_part : std::vector<std::pair<std::size_t, std::size_t>>{};
+    return c ? c->not_part : kNone;
   }
 
  private:

@@ -9,7 +9,7 @@ namespace nonplanar::program {
 
 namespace {
 constexpr double kCell = 1.0;        ///< mm
-constexpr int kMostCells = 1 << 22;  ///< a 2 m bed at 1 mm; past it the cells grow coarser
+constexpr int kMostCells = 1 << 22;  ///< a 2 m bed at 1 mm; past it no cells (nothing to clear)
 }  // namespace
 
 PrintedTop::PrintedTop(const Vec2& lo, const Vec2& hi) : lo_(lo) {
@@ -59,6 +59,12 @@ double PrintedTop::over(const Vec2& a, const Vec2& b, double r) const {
       if ((a + s * ab - c).norm() <= reach) best = t;
     }
   return best;
+}
+
+double PrintedTop::to_clear(const Vec3& a, const Vec3& b, double r, double top) const {
+  const double ends = std::max({top, a.z(), b.z()});
+  if (highest_ <= ends) return top;  // (most travels: nothing laid stands that high)
+  return std::max(top, over(a.head<2>(), b.head<2>(), r));
 }
 
 }  // namespace nonplanar::program

@@ -24,8 +24,10 @@ class PrintedTop {
   /// The highest material laid within `r` mm of the segment a–b seen from above (its cells,
   /// grown by r); -inf when none.
   double over(const Vec2& a, const Vec2& b, double r) const;
-  /// The highest material laid anywhere (-inf: none).
-  double highest() const { return highest_; }
+  /// What a travel from a to b over a layer whose top is `top` must clear (mm): the highest
+  /// material laid within `r` of its way, where that stands higher than `top` and both ends;
+  /// else `top`.
+  double to_clear(const Vec3& a, const Vec3& b, double r, double top) const;
 
  private:
   void lay(const Vec3& p);
