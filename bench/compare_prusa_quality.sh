@@ -19,6 +19,7 @@ if ((${#models[@]} == 0)); then
   models=("$tmp"/solids/saddle.stl "$tmp"/solids/sine_roof.stl "$tmp"/solids/domed_towers.stl
           "$tmp"/solids/dome_cut_by_box.stl "$tmp"/solids/rib.stl "$tmp"/solids/rib_beside_tower.stl
           "$tmp"/solids/hollow_roof_1.5mm.stl "$tmp"/solids/hollow_roof_0.8mm.stl
+          "$tmp"/solids/rib_and_domed_tower.stl
           ../shared/models/np_curvislicer_wing.stl
           ../shared/models/np_curvislicer_FoilCutter.stl ../shared/models/np_prusa_sphere.stl
           examples/wave_roof.stl ../shared/models/np_curvislicer_anklebase_small.stl

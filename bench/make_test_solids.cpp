@@ -26,7 +26,8 @@ int main(int argc, char** argv) {
       {"rib_beside_tower.stl", t::rib_beside_tower()},
       {"hollow_roof_1.5mm.stl", t::hollow_roof(1.5)},
       {"hollow_roof_0.8mm.stl", t::hollow_roof(0.8)},
-      {"two_reliefs.stl", t::two_reliefs()}};
+      {"two_reliefs.stl", t::two_reliefs()},
+      {"rib_and_domed_tower.stl", t::rib_and_domed_tower()}};
   for (const auto& [name, mesh] : solids) {
     auto w = nonplanar::write_stl(dir / name, mesh);
     if (!w) {

@@ -58,13 +58,17 @@ Expected<EngineOutput> slice_with(const TriangleMesh& to_slice, const LayerField
 
 Expected<EngineOutput> shell_with(const TriangleMesh& mesh,
                                   const std::vector<layers::ShellPlan>& plans,
-                                  const EngineRoute& route, const Context& ctx) {
+                                  const EngineRoute& route, const Context& ctx,
+                                  const LayerField* stacks) {
   EngineOutput out;
   if (route.engine.engine == Engine::builtin) {
-    auto paths = shell_toolpaths(mesh, plans, route.print, ctx);
+    auto paths = shell_toolpaths(mesh, plans, route.print, ctx, {stacks, route.map_back});
     if (!paths) return paths.error();
     out.layers = std::move(*paths);
   } else {
+    if (stacks)
+      return Error{Status::unsupported,
+                   "through an engine, a part prints stacks or a shell, not both"};
     if (plans.size() != 1)
       return Error{Status::internal_error,
                    "an engine prints one shell, not " + std::to_string(plans.size())};

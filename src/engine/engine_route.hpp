@@ -41,10 +41,12 @@ Expected<EngineOutput> slice_with(const TriangleMesh& to_slice, const LayerField
 /// The shell plans printed by the route's engine: the built-in core and shells
 /// (shell_toolpaths), or the external engine's two runs stitched into one program
 /// (shell_with_engine: one shell only). Errors: unsupported (the engine's core is off the
-/// plan's boundaries), those of the stages and the engine, cancelled.
+/// plan's boundaries), those of the stages and the engine, cancelled. `stacks`: curved stacks
+/// in the core (shell_toolpaths' CoreStacks field), built-in engine only (else unsupported).
 Expected<EngineOutput> shell_with(const TriangleMesh& mesh,
                                   const std::vector<layers::ShellPlan>& plans,
-                                  const EngineRoute& route, const Context& ctx);
+                                  const EngineRoute& route, const Context& ctx,
+                                  const LayerField* stacks = nullptr);
 
 /// Our header over an external engine's file: the route, `header` (what was curved) and the
 /// settings forced on the engine's runs; shell_first_layer > 0: the shell route's, with its

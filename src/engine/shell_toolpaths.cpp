@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <optional>
 
 #include "core/parallel.hpp"
 #include "core/polygon_ops.hpp"
@@ -17,10 +18,10 @@ namespace {
 // where z_k <= B + a, i.e. where H >= z_k − a + N·t; where the part stands above a top
 // somewhere, cut back only inside that shell's R (R[i] of plans[i]).
 Expected<std::vector<SlicedLayer>> core_layers(const TriangleMesh& mesh,
+                                               const std::vector<double>& z,
                                                const std::vector<layers::ShellPlan>& plans,
                                                const std::vector<std::vector<ExPolygon>>& R,
                                                const Context& ctx) {
-  const std::vector<double>& z = plans.front().core;
   std::vector<SlicedLayer> spans;
   for (std::size_t k = 1; k < z.size(); ++k) {
     SlicedLayer l;
@@ -235,8 +236,8 @@ Expected<std::vector<LayerToolpaths>> shell_layers(const TriangleMesh& mesh,
 
 Expected<std::vector<LayerToolpaths>> shell_toolpaths(const TriangleMesh& mesh,
                                                       const std::vector<layers::ShellPlan>& plans,
-                                                      const PrintConfig& print,
-                                                      const Context& ctx) {
+                                                      const PrintConfig& print, const Context& ctx,
+                                                      const CoreStacks& stacks) {
   if (plans.empty()) return Error{Status::internal_error, "shell_toolpaths: no shell"};
   std::vector<std::vector<ExPolygon>> R;
   std::vector<std::vector<LayerToolpaths>> shells;
@@ -248,14 +249,34 @@ Expected<std::vector<LayerToolpaths>> shell_toolpaths(const TriangleMesh& mesh,
     if (!paths) return paths.error();
     shells.push_back(std::move(*paths));
   }
-  auto core = core_layers(mesh, plans, R, ctx);
+  // With stacks the core is cut from the normalised mesh: outside the stacks' bands its
+  // layers are the planar ones, and the cut under the shells lies there.
+  // A stack may hold more layers than the planar ones it replaces: the core goes on, h_c at a
+  // time, as high as the normalised mesh.
+  std::optional<NormalizedMesh> normalized;
+  std::vector<double> z = plans.front().core;
+  if (stacks.field) {
+    auto n = normalize_mesh(mesh, *stacks.field, {}, ctx);
+    if (!n) return n.error();
+    normalized = std::move(*n);
+    const double top = bounding_box(normalized->mesh).max.z();
+    const double h_c = z.size() >= 3 ? z[z.size() - 1] - z[z.size() - 2] : 0;
+    while (h_c > 0 && z.back() < top - 1e-9) z.push_back(z.back() + h_c);
+  }
+  auto core = core_layers(normalized ? normalized->mesh : mesh, z, plans, R, ctx);
   if (!core) return core.error();
+  normalized.reset();
   ctx.progress("core", 1.0);
   std::vector<LayerToolpaths> core_paths;
   if (!core->empty()) {
     auto paths = make_toolpaths(*core, print.paths, ctx);
     if (!paths) return paths.error();
     core_paths = std::move(*paths);
+  }
+  if (stacks.field && !core_paths.empty()) {
+    auto mapped = map_toolpaths_back(core_paths, *stacks.field, stacks.map_back, ctx);
+    if (!mapped) return mapped.error();
+    core_paths = std::move(*mapped);
   }
   if (plans.front().region.empty() || core_paths.empty()) {
     std::vector<LayerToolpaths> out = std::move(core_paths);

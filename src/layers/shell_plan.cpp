@@ -170,7 +170,7 @@ double ShellPlan::thickness(int j, double x, double y) const {
 }
 
 ShellPlan plan_shell(const TriangleMesh& mesh, const Analysis& a, const std::vector<int>& patches,
-                     const LayerParams& p, double frame) {
+                     const LayerParams& p, double frame, bool even_core) {
   ShellPlan s;
   s.patches = patches;
   // The patches as one: their facets, box and height range (what faceted_top reads).
@@ -249,7 +249,7 @@ ShellPlan plan_shell(const TriangleMesh& mesh, const Analysis& a, const std::vec
   end = std::min(end, box.max.z());
   std::vector<double> targets;
   for (const Patch& q : a.patches)
-    if (q.verdict == PatchVerdict::flat && q.z_max - q.z_min < 0.05)
+    if (!even_core && q.verdict == PatchVerdict::flat && q.z_max - q.z_min < 0.05)
       targets.push_back(0.5 * (q.z_min + q.z_max));  // the wing's tilted floor: 3.55–3.58 mm
   if (!s.region.empty()) end = box.max.z();          // the part outside R goes on above the shell
   // The first layer is the profile's where no stair of the shell's lowest layer comes down to
@@ -264,10 +264,22 @@ ShellPlan plan_shell(const TriangleMesh& mesh, const Analysis& a, const std::vec
   return s;
 }
 
-ShellPlan choose_shell(const TriangleMesh& mesh, const Analysis& a, const LayerParams& p) {
-  std::vector<int> all;
+namespace {
+
+// The curved patches among `among` (empty: all of them).
+std::vector<int> curved_among(const Analysis& a, const std::vector<int>& among) {
+  std::vector<int> out;
   for (std::size_t i = 0; i < a.patches.size(); ++i)
-    if (a.patches[i].needs_nonplanar()) all.push_back(static_cast<int>(i));
+    if (a.patches[i].needs_nonplanar() &&
+        (among.empty() ||
+         std::find(among.begin(), among.end(), static_cast<int>(i)) != among.end()))
+      out.push_back(static_cast<int>(i));
+  return out;
+}
+
+ShellPlan choose_first(const TriangleMesh& mesh, const Analysis& a, const LayerParams& p,
+                       const ShellChoice& c) {
+  const std::vector<int> all = curved_among(a, c.among);
   if (all.empty()) {
     ShellPlan none;
     none.refused = "no patch needs curved layers";
@@ -280,28 +292,41 @@ ShellPlan choose_shell(const TriangleMesh& mesh, const Analysis& a, const LayerP
   const bool group = near.size() > 1 && near.size() < all.size();
   ShellPlan plan, some;
   core::parallel_for(0, group ? 2 : 1, [&](int k) {
-    if (k == 0) plan = plan_shell(mesh, a, all, p);
-    if (k == 1) some = plan_shell(mesh, a, near, p);
+    if (k == 0) plan = plan_shell(mesh, a, all, p, 0, c.even_core);
+    if (k == 1) some = plan_shell(mesh, a, near, p, 0, c.even_core);
   });
   if (!plan.refused.empty() && group && some.refused.empty()) return some;
   if (!plan.refused.empty() && all.size() > 1) {
-    ShellPlan one = plan_shell(mesh, a, {all.front()}, p);
+    ShellPlan one = plan_shell(mesh, a, {all.front()}, p, 0, c.even_core);
     if (one.refused.empty()) plan = std::move(one);
   }
   return plan;
 }
 
+}  // namespace
+
+ShellPlan choose_shell(const TriangleMesh& mesh, const Analysis& a, const LayerParams& p) {
+  return choose_first(mesh, a, p, {});
+}
+
 std::vector<ShellPlan> choose_shells(const TriangleMesh& mesh, const Analysis& a,
                                      const LayerParams& p, int most) {
+  ShellChoice c;
+  c.most = most;
+  return choose_shells(mesh, a, p, c);
+}
+
+std::vector<ShellPlan> choose_shells(const TriangleMesh& mesh, const Analysis& a,
+                                     const LayerParams& p, const ShellChoice& c) {
+  const int most = c.most;
   std::vector<ShellPlan> shells;
-  shells.push_back(choose_shell(mesh, a, p));
+  shells.push_back(choose_first(mesh, a, p, c));
   const ShellPlan& first = shells.front();
   if (!first.refused.empty() || first.region.empty()) return shells;
   std::vector<int> rest;
-  for (std::size_t i = 0; i < a.patches.size(); ++i)
-    if (a.patches[i].needs_nonplanar() && std::find(first.patches.begin(), first.patches.end(),
-                                                    static_cast<int>(i)) == first.patches.end())
-      rest.push_back(static_cast<int>(i));
+  for (int i : curved_among(a, c.among))
+    if (std::find(first.patches.begin(), first.patches.end(), i) == first.patches.end())
+      rest.push_back(i);
   // Each plan costs a raster and its distance maps (0.1–0.3 s on the bunny): twice as many
   // tries as shells wanted, the largest groups first, none under 1 % of the curved area.
   double curved = 0;
@@ -333,9 +358,9 @@ std::vector<ShellPlan> choose_shells(const TriangleMesh& mesh, const Analysis& a
   core::parallel_for(std::size_t(0), groups.size(), [&](std::size_t k) {
     const std::vector<int>& group = groups[k];
     if (!apart(patch_box(a, group), patch_box(a, first.patches), p.toolhead.reach())) return;
-    tried[k] = plan_shell(mesh, a, group, p, frame);
+    tried[k] = plan_shell(mesh, a, group, p, frame, c.even_core);
     if (!tried[k].refused.empty() && group.size() > 1)
-      tried[k] = plan_shell(mesh, a, {group.front()}, p, frame);
+      tried[k] = plan_shell(mesh, a, {group.front()}, p, frame, c.even_core);
   });
   for (std::size_t k = 0; k < groups.size() && static_cast<int>(shells.size()) < most; ++k) {
     if (near_a_shell(groups[k])) continue;

@@ -75,8 +75,10 @@ struct ShellPlan {
 /// layers by slot_level. The core's boundaries land on every flat patch's height that they can
 /// reach in steps within [h_min, h_c]. `frame` > 0: H covers only the patches' box grown by
 /// that much (mm), and R stops short of its edge (plan.framed).
+/// `even_core`: every core layer h_c thick after the first (no landing on flat patches), so
+/// the core's boundaries are planar layers PlanarLayers{z_1, h_c} that stacks can share.
 ShellPlan plan_shell(const TriangleMesh& mesh, const Analysis& a, const std::vector<int>& patches,
-                     const LayerParams& p, double frame = 0);
+                     const LayerParams& p, double frame = 0, bool even_core = false);
 
 /// The shell `slice` tries when no stack can be built, or when the stacks cover less than half
 /// the largest curved patch: all the patches that need curved layers as one top, or failing
@@ -93,6 +95,16 @@ ShellPlan choose_shell(const TriangleMesh& mesh, const Analysis& a, const LayerP
 /// (and as many groups tried); the first may be refused (nothing else then).
 std::vector<ShellPlan> choose_shells(const TriangleMesh& mesh, const Analysis& a,
                                      const LayerParams& p, int most = 4);
+
+/// Which shells to choose among.
+struct ShellChoice {
+  int most = 4;            ///< shells at most
+  std::vector<int> among;  ///< the patches to follow (empty: every one that needs curved layers)
+  bool even_core = false;  ///< plan_shell's: a core whose layers stacks can share
+};
+/// choose_shells over `c.among` only (the patches no stack serves, beside the stacks).
+std::vector<ShellPlan> choose_shells(const TriangleMesh& mesh, const Analysis& a,
+                                     const LayerParams& p, const ShellChoice& c);
 
 /// The shell's layer field: T = N + (z − H)/t, ζ = base + t·T, so the normalised mesh holds
 /// the shell's layers as planes ζ = base + j·t … base + (j + 1)·t. Every column is curved.

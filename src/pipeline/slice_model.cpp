@@ -6,6 +6,7 @@
 #include <functional>
 #include <optional>
 
+#include "core/column_caster.hpp"
 #include "engine/engine_route.hpp"
 #include "layers/banded_field.hpp"
 #include "nonplanar/deform.hpp"
@@ -233,11 +234,14 @@ void describe_shells(const std::vector<layers::ShellPlan>& shells, const std::st
 // notice then says why).
 // `spent` is called once the shells are sliced, before the gate: their rasters are no longer
 // needed then, unless the caller retries with one of them.
+// `stacks`: curved stacks the core holds beside the shells (shells_beside_stacks), on the
+// core's layers.
 Expected<std::optional<SliceResult>> try_shell(const TriangleMesh& mesh, const SliceJob& job,
                                                const std::vector<layers::ShellPlan>& shells,
                                                const std::string& why_shell, SliceResult& planar,
                                                const std::function<void()>& spent,
-                                               const Context& ctx) {
+                                               const Context& ctx,
+                                               const LayerPlan* stacks = nullptr) {
   const std::vector<int> patches = shell_patches(shells);
   if (patches.empty()) return std::optional<SliceResult>{};
   const layers::ShellPlan& plan = shells.front();
@@ -259,7 +263,7 @@ Expected<std::optional<SliceResult>> try_shell(const TriangleMesh& mesh, const S
   }
   SliceResult r;
   const EngineRoute route{job.engine, job.print, job.layers, job.map_back};
-  auto printed = shell_with(mesh, shells, route, ctx);
+  auto printed = shell_with(mesh, shells, route, ctx, stacks ? stacks->field.get() : nullptr);
   if (!printed && printed.error().status == Status::unsupported) {
     planar.notices.push_back(refused(printed.error().message));
     return std::optional<SliceResult>{};
@@ -268,6 +272,16 @@ Expected<std::optional<SliceResult>> try_shell(const TriangleMesh& mesh, const S
   r.layers = std::move(printed->layers);
   r.gcode = std::move(printed->gcode);
   describe_shells(shells, why_shell, planar, r);
+  if (stacks) {
+    for (const LayerStack& st : stacks->stacks) {
+      char buf[160];
+      std::snprintf(buf, sizeof buf, "patch %d: %d curved layers from z = %.2f mm", st.patch,
+                    st.layers, st.c);
+      r.header.push_back(buf);
+    }
+    r.plan = *stacks;
+    r.printed_curved += static_cast<int>(stacks->stacks.size());
+  }
   if (!r.gcode.empty()) r.gcode = engine_header(route, r.header, plan.core.at(1)) + r.gcode;
   r.nonplanar = true;
   spent();
@@ -340,6 +354,101 @@ Expected<std::optional<SliceResult>> shell_over_stacks(const TriangleMesh& mesh,
     return std::string(buf);
   };
   return try_shells(mesh, job, a, std::move(shells), why, 2 * stacks, stacked, ctx);
+}
+
+// Where a shell cuts the core inside a stack's band (none: nowhere). Core layer k is cut
+// inside a shell's R where z_k > B + a, at the core's planar height, which a band's curved
+// layers are not at. Looked at every 0.5 mm of each band's reach (1 mm of slack): material
+// there above B + a and below the band's top, from its plane c up.
+std::optional<Vec2> cut_in_a_band(const TriangleMesh& mesh, const layers::BandedField& field,
+                                  const std::vector<layers::ShellPlan>& shells) {
+  const ColumnCaster columns(mesh);
+  for (std::size_t b = 0; b < field.bands().size(); ++b) {
+    const layers::BandedField::Reach& reach = field.reach()[b];
+    const double c = field.bands()[b].c;
+    for (double x = reach.lo.x() - 1; x <= reach.hi.x() + 1; x += 0.5)
+      for (double y = reach.lo.y() - 1; y <= reach.hi.y() + 1; y += 0.5)
+        for (const layers::ShellPlan& s : shells) {
+          const double cut = s.bottom(x, y) + s.reach;
+          if (!s.in_region(x, y) || cut >= reach.z_top) continue;
+          for (const auto& [lo, hi] : columns.intervals(x, y))
+            if (hi > std::max(cut, c) + 1e-6 && lo < reach.z_top) return Vec2(x, y);
+        }
+  }
+  return std::nullopt;
+}
+
+// Stacks and shells in one part (#19): the curved patches the stacks of `stacked` (sliced and
+// passed) leave planar get shells, over a core that holds the stacks' curved layers. The
+// shells' core has even layers (h_c after the first), and the stacks are planned again on
+// them, so one field bends the core's layers under the stacks and is planar where the shells
+// cut the core back. Only with the built-in engine (an engine's run cannot stop its core for
+// the shells), only shells that print where the part stands nowhere above them (R), only when
+// every stack plans again and no shell cuts the core inside a band. None: print `stacked`.
+Expected<std::optional<SliceResult>> shells_beside_stacks(const TriangleMesh& mesh,
+                                                          const SliceJob& job, const Prepared& pre,
+                                                          SliceResult& stacked,
+                                                          const Context& ctx) {
+  const std::optional<SliceResult> none;
+  const Analysis& a = pre.analysis;
+  if (job.engine.engine != Engine::builtin || job.one_run_shells || stacked.plan.stacks.empty())
+    return none;
+  const std::vector<int> stacked_ids = stacked_patches(stacked.plan);
+  std::vector<int> rest, curved;
+  for (std::size_t i = 0; i < a.patches.size(); ++i) {
+    if (!a.patches[i].needs_nonplanar()) continue;
+    curved.push_back(static_cast<int>(i));
+    if (std::find(stacked_ids.begin(), stacked_ids.end(), static_cast<int>(i)) == stacked_ids.end())
+      rest.push_back(static_cast<int>(i));
+  }
+  // Too little left to be worth a core of thinner layers (h_c) under the whole part.
+  constexpr double kLeast = 0.05;
+  if (rest.empty() || area_of(a, rest) < kLeast * area_of(a, curved)) return none;
+  ctx.progress("shell", 0);
+  // Why not, said of the patches left planar (the run's summary gives the first reason).
+  auto not_beside = [&](const std::string& why) {
+    stacked.notices.push_back(
+        {Notice::Kind::shell_refused, -1,
+         patch_names(rest) + " not printed as a shell beside the stacks: " + why});
+    return none;
+  };
+  layers::ShellChoice choice;
+  choice.among = rest, choice.even_core = true;
+  std::vector<layers::ShellPlan> shells = layers::choose_shells(mesh, a, job.layers, choice);
+  const layers::ShellPlan& first = shells.front();
+  if (!first.refused.empty()) return not_beside(first.refused);
+  if (first.core.size() < 3) return not_beside("no room for a core under it");
+  for (const layers::ShellPlan& sh : shells)
+    if (sh.region.empty())
+      return not_beside("the part stands nowhere above it, so it would cover the stacks too");
+  LayerParams on_core = job.layers;
+  on_core.first_layer_height = first.core[1];
+  on_core.layer_height = first.core[2] - first.core[1];
+  std::vector<SurfaceFit> fits;
+  std::vector<int> ids;
+  for (std::size_t i = 0; i < pre.ids.size(); ++i)
+    if (std::find(stacked_ids.begin(), stacked_ids.end(), pre.ids[i]) != stacked_ids.end())
+      fits.push_back(pre.fits[i]), ids.push_back(pre.ids[i]);
+  auto plan = plan_layers(mesh, a, fits, ids, on_core, ctx);
+  if (!plan) return plan.error();
+  const auto* banded = dynamic_cast<const layers::BandedField*>(plan->field.get());
+  char buf[200];
+  if (plan->stacks.size() != stacked_ids.size() || !banded) {
+    std::snprintf(buf, sizeof buf, "a stack does not fit the core's %.2f mm layers",
+                  on_core.layer_height);
+    return not_beside(buf);
+  }
+  if (const auto at = cut_in_a_band(mesh, *banded, shells)) {
+    std::snprintf(buf, sizeof buf,
+                  "it would cut the core back where a stack bends its layers, near (%.2f, %.2f)",
+                  at->x(), at->y());
+    return not_beside(buf);
+  }
+  const std::string why = std::to_string(plan->stacks.size()) +
+                          (plan->stacks.size() == 1 ? " curved stack" : " curved stacks") +
+                          " beside it";
+  return try_shell(
+      mesh, job, shells, why, stacked, [] {}, ctx, &*plan);
 }
 
 }  // namespace
@@ -439,6 +548,13 @@ Expected<SliceResult> slice_rounds(const TriangleMesh& mesh, const SliceJob& job
     }
     if (offenders.empty()) {
       r->notices.insert(r->notices.begin(), dropped.begin(), dropped.end());
+      // Not after a shell over the stacks was refused: the same refusal, as a rule, again (on
+      // Benchy, the map's size: 1.1 s more for nothing).
+      if (shells && r->nonplanar && !over_stacks_tried) {
+        auto both = shells_beside_stacks(mesh, job, pre, *r, ctx);
+        if (!both) return both.error();
+        if (*both) return done(std::move(**both));
+      }
       return done(std::move(r));
     }
     // A stack that met every limit on its own grid broke one in the final paths: print

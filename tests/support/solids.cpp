@@ -164,6 +164,17 @@ TriangleMesh rib_against_tower() {
   return m;
 }
 
+TriangleMesh rib_and_domed_tower() {
+  TriangleMesh m = height_field_solid(
+      [](double x, double) { return 0.3 + 12 * std::sin(M_PI * x / 100); }, 0, 60, 0, 12, 120, 12);
+  append(m, height_field_solid(
+                [](double x, double y) {
+                  return 18 + 2 * std::cos(0.1 * (x - 95)) * std::cos(0.1 * (y - 6));
+                },
+                80, 110, -9, 21, 60, 60));
+  return m;
+}
+
 TriangleMesh two_reliefs() {
   auto top = [](double x, double y) {
     if (x < 25) return 4 + 3 * std::sin(2 * M_PI * x / 25) * std::cos(y / 8);

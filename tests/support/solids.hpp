@@ -63,6 +63,11 @@ TriangleMesh hollow_roof(double wall);
 /// shared bunny takes, at a thousandth of its cost).
 TriangleMesh two_reliefs();
 
+/// rib and domed tower: a rib 60 × 12 mm, top 0.3 + 12 sin(πx / 100) (no stack fits it), and
+/// 20 mm past its end a 30 × 30 mm tower, top 18 + 2 cos(0.1 dx) cos(0.1 dy) about its centre
+/// (x 80–110, y −9–21): a stack for the tower, a shell for the rib, planar walls between.
+TriangleMesh rib_and_domed_tower();
+
 /// The shared test models folder (../shared/models beside the repo); empty if absent.
 std::filesystem::path shared_models();
 
