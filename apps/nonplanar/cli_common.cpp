@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <stdexcept>
 
 #include "core/atomic_file.hpp"
 #include "core/sanitizers.hpp"
@@ -228,6 +229,21 @@ void add_analysis_options(CLI::App& cmd, AnalysisParams& p) {
 Expected<void> check_max_angle(double max_angle_deg) {
   if (max_angle_deg > 0 && max_angle_deg < 90) return {};
   return Error{Status::invalid_argument, "max_angle: must be in (0, 90) degrees"};
+}
+
+Expected<SectionAt> parse_section_at(const std::string& at) {
+  if (at.size() < 3 || (at[0] != 'x' && at[0] != 'y') || at[1] != '=')
+    return Error{Status::invalid_argument, "--at: expected x=VALUE or y=VALUE"};
+  SectionAt out;
+  out.axis = at[0];
+  try {
+    std::size_t used = 0;
+    out.value = std::stod(at.substr(2), &used);
+    if (used != at.size() - 2 || !std::isfinite(out.value)) throw std::invalid_argument(at);
+  } catch (...) {
+    return Error{Status::invalid_argument, "--at: '" + at.substr(2) + "' is not a number"};
+  }
+  return out;
 }
 
 namespace {

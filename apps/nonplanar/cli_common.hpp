@@ -81,6 +81,14 @@ struct ProfileOptions {
 /// max_angle in (0, 90) degrees (NaN refused), or the error every subcommand gives.
 Expected<void> check_max_angle(double max_angle_deg);
 
+/// A section plane as --at gives it: "x=VALUE" or "y=VALUE" (mm). Errors: invalid_argument
+/// naming --at.
+struct SectionAt {
+  char axis = 'y';
+  double value = 0;
+};
+Expected<SectionAt> parse_section_at(const std::string& at);
+
 /// One "KEY=VALUE" override; `known` is false for a key our settings do not have.
 struct Setting {
   std::string key, value;

@@ -55,18 +55,11 @@ int run(const LayersOptions& o) {
   const LayerParams& lp = job->layers;
   if (!o.mesh.quiet && !o.json)
     for (const Notice& n : job->notices) std::fprintf(stderr, "notice: %s\n", n.text.c_str());
-  char axis = 0;
-  double at = 0;
+  SectionAt at;
   if (!o.section.empty()) {
-    if (o.at.size() < 3 || (o.at[0] != 'x' && o.at[0] != 'y') || o.at[1] != '=')
-      return report_error({Status::invalid_argument, "--at: expected x=VALUE or y=VALUE"});
-    try {
-      at = std::stod(o.at.substr(2));
-    } catch (...) {
-      return report_error(
-          {Status::invalid_argument, "--at: '" + o.at.substr(2) + "' is not a number"});
-    }
-    axis = o.at[0];
+    auto a = parse_section_at(o.at);
+    if (!a) return report_error(a.error());
+    at = *a;
   }
   Context ctx = make_context(o.mesh.quiet || o.json);
   LoadParams load = o.mesh.load;
@@ -105,8 +98,8 @@ int run(const LayersOptions& o) {
       }
     if (auto w = write_surfaces_json(o.export_layers, recs); !w) return report_error(w.error());
   }
-  if (axis)
-    if (auto w = write_section_svg(o.section, loaded->mesh, *plan, axis, at); !w)
+  if (!o.section.empty())
+    if (auto w = write_section_svg(o.section, loaded->mesh, *plan, at.axis, at.value); !w)
       return report_error(w.error());
 
   if (o.json) {

@@ -13,6 +13,7 @@
 #include "nonplanar/check.hpp"
 #include "nonplanar/gcode.hpp"
 #include "nonplanar/pipeline.hpp"
+#include "nonplanar/print_plan.hpp"
 
 namespace nonplanar::cli {
 
@@ -48,9 +49,29 @@ namespace {
 struct PreviewOptions {
   MeshOptions mesh;
   ProfileOptions profile;
-  std::string gcode, output;
+  std::string gcode, output, section, at;
   double max_angle = 30;
 };
+
+// --section: the beads crossing a vertical plane, as SVG, instead of the page.
+int write_section(const PreviewOptions& o, std::string_view text, const PrintConfig& cfg,
+                  const TriangleMesh* mesh) {
+  auto at = parse_section_at(o.at);
+  if (!at) return report_error(at.error());
+  const GcodeProgram program = read_gcode_program(text);
+  PreviewParams params;
+  params.filament_diameter = cfg.gcode.filament_diameter;
+  params.travels = false;
+  auto svg = bead_section_svg(preview_buffers(program, {}, params), mesh, at->axis, at->value);
+  if (!svg) return report_error({svg.error().status, o.gcode + ": " + svg.error().message});
+  auto w = write_file_atomically(o.section, [&](std::ostream& os) {
+    os.write(svg->data(), static_cast<std::streamsize>(svg->size()));
+    return bool(os);
+  });
+  if (!w) return report_error(w.error());
+  if (!o.mesh.quiet) std::fprintf(stderr, "wrote %s\n", o.section.c_str());
+  return kExitOk;
+}
 
 // Where check's figures break the layer limits the slicer plans for (make_job's).
 std::vector<Vec3> breaches(const CheckFigures& f, const PrintConfig& cfg, double max_angle) {
@@ -64,8 +85,14 @@ std::vector<Vec3> breaches(const CheckFigures& f, const PrintConfig& cfg, double
 
 int run(const PreviewOptions& o) {
   if (auto a = check_max_angle(o.max_angle); !a) return report_error(a.error());
+  if (!o.section.empty() && !o.output.empty())
+    return report_error(
+        {Status::invalid_argument, "--section and -o: give one (a picture or a page)"});
+  if (o.section.empty() && !o.at.empty())
+    return report_error({Status::invalid_argument, "--at: goes with --section"});
   const std::string html = o.output.empty() ? preview_path_for(o.gcode) : o.output;
-  if (auto c = check_outputs({o.gcode, o.mesh.model}, {html}); !c) return report_error(c.error());
+  const std::string out = o.section.empty() ? html : o.section;
+  if (auto c = check_outputs({o.gcode, o.mesh.model}, {out}); !c) return report_error(c.error());
   auto bytes = core::read_file_bytes(o.gcode, 2ull << 30);
   if (!bytes) return report_error({bytes.error().status, o.gcode + ": " + bytes.error().message});
   auto cfg = o.profile.load(file_config(o.gcode, bytes->view(), o.mesh.quiet));
@@ -75,6 +102,18 @@ int run(const PreviewOptions& o) {
   PreviewSummary summary;
   summary.max_angle_deg = o.max_angle;
   LoadedMesh loaded;
+  if (!o.section.empty()) {
+    if (!o.mesh.model.empty()) {
+      LoadParams lp = o.mesh.load;
+      lp.bed_center = cfg->bed_center();
+      if (const auto centre = post_processed_centre(bytes->view())) lp.bed_center = *centre;
+      auto m = load_mesh(o.mesh.model, lp, ctx);
+      finish_progress();
+      if (!m) return report_error(m.error());
+      loaded = std::move(*m);
+    }
+    return write_section(o, bytes->view(), *cfg, o.mesh.model.empty() ? nullptr : &loaded.mesh);
+  }
   if (!o.mesh.model.empty()) {
     // The figures check gives, from the same reading check makes (strict: what it cannot
     // read is an error here too).
@@ -123,6 +162,10 @@ void register_preview(CLI::App& app, std::function<int()>* run_fn) {
   cmd->add_option("gcode", o->gcode, "G-code file")->required();
   cmd->add_option("--mesh", o->mesh.model, "The mesh it was sliced from (optional)");
   cmd->add_option("-o,--output", o->output, "HTML file to write (default: GCODE with .html)");
+  cmd->add_option("--section", o->section,
+                  "Instead of the page, an SVG picture of the beads crossing a vertical plane\n"
+                  "(--at): curved layers orange, planar blue, the mesh's outline with --mesh");
+  cmd->add_option("--at", o->at, "Where --section cuts: x=VALUE or y=VALUE (mm)");
   o->profile.add_to(*cmd, "bed, filament, layer limits, the toolhead (over the file's own)");
   cmd->add_option("--scale", o->mesh.load.scale, "Scale applied when slicing");
   cmd->add_option("--max-angle", o->max_angle, "Printable facet slope (deg)")

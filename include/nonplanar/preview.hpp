@@ -84,4 +84,13 @@ struct PreviewSummary {
 std::string preview_html(const PreviewBuffers& buffers, const TriangleMesh* mesh,
                          const PreviewMarks& marks, const PreviewSummary& summary);
 
+/// A vertical cross-section of the printed beads, as SVG: every extrusion segment of `b` that
+/// crosses the plane (axis 'x' or 'y' = value, mm) drawn as its bead's section there (its
+/// width in the plane × its thickness, the top at the segment's z), curved layers orange and
+/// planar ones blue, alternate layers lighter; with `mesh` (placed like the G-code), its
+/// outline in the plane. Errors: invalid_argument for another axis or a plane no extrusion
+/// crosses.
+Expected<std::string> bead_section_svg(const PreviewBuffers& b, const TriangleMesh* mesh, char axis,
+                                       double value);
+
 }  // namespace nonplanar

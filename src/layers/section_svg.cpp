@@ -2,30 +2,15 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <iomanip>
 #include <sstream>
 
 #include "core/atomic_file.hpp"
 #include "core/column_caster.hpp"
+#include "core/section_plot.hpp"
 #include "nonplanar/layers.hpp"
 
 namespace nonplanar {
-namespace {
-
-struct Mapper {  // section coordinates (s, z) in mm → SVG pixels
-  double s0, z1, scale, left, top;
-  double X(double s) const { return left + (s - s0) * scale; }
-  double Y(double z) const { return top + (z1 - z) * scale; }
-};
-
-double nice_step(double range) {
-  const double raw = range / 8;
-  const double p = std::pow(10.0, std::floor(std::log10(raw)));
-  for (double m : {1.0, 2.0, 5.0, 10.0})
-    if (m * p >= raw) return m * p;
-  return 10 * p;
-}
-
-}  // namespace
 
 Expected<void> write_section_svg(const std::filesystem::path& file, const TriangleMesh& mesh,
                                  const LayerPlan& plan, char axis, double value) {
@@ -42,26 +27,11 @@ Expected<void> write_section_svg(const std::filesystem::path& file, const Triang
   auto point = [&](double s) { return axis == 'x' ? Vec2(value, s) : Vec2(s, value); };
 
   // Part outline: the plane's cut through every triangle it crosses.
-  std::vector<std::array<double, 4>> outline;
-  for (const auto& f : mesh.faces) {
-    std::vector<Vec2> cut;
-    for (int k = 0; k < 3; ++k) {
-      const Vec3& a = mesh.vertices[f[k]];
-      const Vec3& b = mesh.vertices[f[(k + 1) % 3]];
-      const double da = a[1 - hs] - value, db = b[1 - hs] - value;
-      if ((da < 0) != (db < 0)) {
-        const Vec3 p = a + da / (da - db) * (b - a);
-        cut.emplace_back(p[hs], p.z());
-      }
-    }
-    if (cut.size() == 2) outline.push_back({cut[0].x(), cut[0].y(), cut[1].x(), cut[1].y()});
-  }
+  const auto outline = core::section_outline(mesh, axis, value);
   if (outline.empty()) return Error{Status::invalid_argument, "section: the plane misses the part"};
 
   const double s0 = box.min[hs], s1 = box.max[hs], z1 = box.max.z();
-  const double width_px = 1100, scale = width_px / std::max(s1 - s0, 1e-6);
-  const Mapper M{s0, z1, scale, 70, 50};
-  const double height_px = z1 * scale;
+  const core::SectionFrame M(s0, s1, z1, 1100);
 
   // Layer boundaries column by column; curved where they leave the planar height.
   const ColumnCaster columns(mesh);
@@ -105,47 +75,17 @@ Expected<void> write_section_svg(const std::filesystem::path& file, const Triang
   }
   for (char c : layer_is_curved) curved_layers_seen += c;
 
-  std::ostringstream svg;
-  svg.precision(2);
-  svg << std::fixed;
-  const double W = width_px + 110, H = height_px + 110;
-  svg << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << W << "\" height=\"" << H
-      << "\" viewBox=\"0 0 " << W << ' ' << H << "\" font-family=\"sans-serif\" font-size=\"12\">\n"
-      << "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
-  svg << "<text x=\"" << M.left << "\" y=\"22\" font-size=\"15\">Section at " << axis << " = "
-      << value << " mm: " << curved_layers_seen << " curved layer boundaries (orange), "
-      << plan.stacks.size() << " curved band" << (plan.stacks.size() == 1 ? "" : "s") << ", "
-      << plan.fallbacks.size() << " patch" << (plan.fallbacks.size() == 1 ? "" : "es")
-      << " kept planar</text>\n";
-  // Axes with ticks in mm.
-  const double step_s = nice_step(s1 - s0), step_z = nice_step(std::max(z1, 1.0));
-  svg << "<g stroke=\"#444\" stroke-width=\"1\">\n<line x1=\"" << M.X(s0) << "\" y1=\"" << M.Y(0)
-      << "\" x2=\"" << M.X(s1) << "\" y2=\"" << M.Y(0) << "\"/>\n<line x1=\"" << M.X(s0)
-      << "\" y1=\"" << M.Y(0) << "\" x2=\"" << M.X(s0) << "\" y2=\"" << M.Y(z1) << "\"/>\n";
-  for (double t = std::ceil(s0 / step_s) * step_s; t <= s1 + 1e-9; t += step_s)
-    svg << "<line x1=\"" << M.X(t) << "\" y1=\"" << M.Y(0) << "\" x2=\"" << M.X(t) << "\" y2=\""
-        << M.Y(0) + 5 << "\"/>\n";
-  for (double t = 0; t <= z1 + 1e-9; t += step_z)
-    svg << "<line x1=\"" << M.X(s0) - 5 << "\" y1=\"" << M.Y(t) << "\" x2=\"" << M.X(s0)
-        << "\" y2=\"" << M.Y(t) << "\"/>\n";
-  svg << "</g>\n<g fill=\"#222\">\n";
-  for (double t = std::ceil(s0 / step_s) * step_s; t <= s1 + 1e-9; t += step_s)
-    svg << "<text x=\"" << M.X(t) << "\" y=\"" << M.Y(0) + 18 << "\" text-anchor=\"middle\">" << t
-        << "</text>\n";
-  for (double t = 0; t <= z1 + 1e-9; t += step_z)
-    svg << "<text x=\"" << M.X(s0) - 8 << "\" y=\"" << M.Y(t) + 4 << "\" text-anchor=\"end\">" << t
-        << "</text>\n";
-  svg << "<text x=\"" << M.X(0.5 * (s0 + s1)) << "\" y=\"" << M.Y(0) + 36
-      << "\" text-anchor=\"middle\">" << (hs == 1 ? 'y' : 'x')
-      << " (mm)</text>\n<text x=\"18\" y=\"" << M.Y(z1 / 2) << "\" transform=\"rotate(-90 18 "
-      << M.Y(z1 / 2) << ")\" text-anchor=\"middle\">z (mm)</text>\n</g>\n";
+  std::ostringstream svg, title;
+  title << "Section at " << axis << " = " << std::fixed << std::setprecision(2) << value
+        << " mm: " << curved_layers_seen << " curved layer boundaries (orange), "
+        << plan.stacks.size() << " curved band" << (plan.stacks.size() == 1 ? "" : "s") << ", "
+        << plan.fallbacks.size() << " patch" << (plan.fallbacks.size() == 1 ? "" : "es")
+        << " kept planar";
+  core::svg_begin(svg, M, title.str(), hs == 1 ? 'y' : 'x');
   svg << "<path fill=\"none\" stroke=\"#bbb\" stroke-width=\"0.6\" d=\"" << planar_path.str()
       << "\"/>\n<path fill=\"none\" stroke=\"#e8700a\" stroke-width=\"1.1\" d=\""
-      << curved_path.str() << "\"/>\n<g stroke=\"black\" stroke-width=\"1.6\">\n";
-  for (const auto& o : outline)
-    svg << "<line x1=\"" << M.X(o[0]) << "\" y1=\"" << M.Y(o[1]) << "\" x2=\"" << M.X(o[2])
-        << "\" y2=\"" << M.Y(o[3]) << "\"/>\n";
-  svg << "</g>\n</svg>\n";
+      << curved_path.str() << "\"/>\n";
+  core::svg_end(svg, M, outline);
   const std::string text = svg.str();
   return write_file_atomically(file, [&](std::ostream& out) {
     out << text;

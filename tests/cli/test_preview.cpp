@@ -125,6 +125,34 @@ TEST(Preview, WithTheMeshItShowsChecksFigures) {
   EXPECT_NE(r.err.find("curved"), std::string::npos);
 }
 
+// --section: the sine roof's beads crossing y = 110 (its middle), with its outline; no page.
+// Its top is one curved stack: orange beads, and every bead inside the outline's box.
+TEST(Preview, SectionDrawsTheBeadsCrossingAPlane) {
+  const fs::path dir = test::temp_dir("preview_section");
+  const fs::path gcode = sliced_roof(dir);
+  fs::remove(dir / "roof.html");
+  const fs::path svg = dir / "cut.svg";
+  auto r = test::run_cli("preview -q " + gcode.string() + " --mesh " + (dir / "roof.stl").string() +
+                         " --section " + svg.string() + " --at y=110");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "roof.html"));
+  const std::string text = test::read_bytes(svg);
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(text, m, std::regex("([0-9]+) curved layers \\(orange\\)")));
+  EXPECT_GE(std::stoi(m[1]), 10);
+  EXPECT_GT(count_of(text, "fill=\"#d9651b\""), 20u);  // curved beads
+  EXPECT_GT(count_of(text, "<line "), 100u);           // the outline's segments
+  // A plane past the part, a bad --at, --at alone, --section with -o: one line, exit 2.
+  for (const std::string& args :
+       {" --section " + svg.string() + " --at y=500", " --section " + svg.string() + " --at z=1",
+        " --section " + svg.string() + " --at y=1mm", std::string(" --at y=110"),
+        " --section " + svg.string() + " --at y=110 -o " + (dir / "p.html").string()}) {
+    r = test::run_cli("preview " + gcode.string() + args);
+    EXPECT_EQ(r.code, 2) << args;
+    EXPECT_EQ(count_of(r.err, "\n"), 1u) << r.err;
+  }
+}
+
 TEST(Preview, BadInputIsOneLineAndNoPage) {
   const fs::path dir = test::temp_dir("preview_bad");
   auto r = test::run_cli("preview " + (dir / "missing.gcode").string());

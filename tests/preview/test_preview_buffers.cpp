@@ -3,8 +3,11 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <cstring>
+#include <regex>
 #include <string>
+#include <vector>
 
 #include "core/base64.hpp"
 #include "nonplanar/preview.hpp"
@@ -161,6 +164,65 @@ TEST(Base64, MatchesTheRfcVectors) {
   EXPECT_EQ(core::base64_encode("fo"), "Zm8=");
   EXPECT_EQ(core::base64_encode("foo"), "Zm9v");
   EXPECT_EQ(core::base64_encode("foobar"), "Zm9vYmFy");
+}
+
+// The beads in a vertical plane (preview/bead_section.cpp), crossings worked out by hand.
+
+// A purge line, then two layers: a line across y = 5 square to it, one at 45° to it, and one
+// along it (which does not cross it). The second layer is curved: it rises 0.1 mm along x.
+std::string two_layers() {
+  const double a = e_for(0.45, 0.2, 10), d = e_for(0.45, 0.2, std::sqrt(200.0));
+  char buf[1024];
+  std::snprintf(buf, sizeof buf,
+                "G90\nM83\nG1 Z0.3 F600\nG1 X0 Y5 F3000\nG1 X60 Y5 E5 F1500\n"
+                ";LAYER_CHANGE\n;Z:0.2\n;HEIGHT:0.2\nG1 Z0.2\nG1 X2 Y0 F6000\n"
+                ";TYPE:External perimeter\n;WIDTH:0.45\nG1 X2 Y10 E%.5f F1200\n"
+                "G1 X12 Y0 E%.5f\nG1 X2 Y5 F6000\nG1 X12 Y5 E%.5f\n"
+                ";LAYER_CHANGE\n;Z:0.4\n;HEIGHT:0.2\nG1 X2 Y0 Z0.4 F6000\n"
+                "G1 X2 Y10 E%.5f F1200\nG1 X12 Y0 Z0.5 E%.5f\n",
+                a, d, a, a, d);
+  return buf;
+}
+
+struct Rect {
+  double x, y, w, h;
+};
+
+std::vector<Rect> rects(const std::string& svg) {
+  std::vector<Rect> out;
+  const std::regex r(
+      "<rect x=\"([-0-9.]+)\" y=\"([-0-9.]+)\" width=\"([-0-9.]+)\" height=\"([-0-9.]+)\"");
+  for (auto it = std::sregex_iterator(svg.begin(), svg.end(), r); it != std::sregex_iterator();
+       ++it)
+    out.push_back(
+        {std::stod((*it)[1]), std::stod((*it)[2]), std::stod((*it)[3]), std::stod((*it)[4])});
+  return out;
+}
+
+TEST(BeadSection, DrawsEachCrossingAsItsBeadsSection) {
+  const PreviewBuffers b = preview_buffers(read_gcode_program(two_layers()), {}, PreviewParams{});
+  auto svg = bead_section_svg(b, nullptr, 'y', 5.0);
+  ASSERT_TRUE(svg) << svg.error().message;
+  // Two crossings a layer; not the purge line along y = 5, nor the line lying in the plane.
+  const std::vector<Rect> r = rects(*svg);
+  ASSERT_EQ(r.size(), 4u);
+  // Widths in the plane: 0.45 square to it, 0.45 / sin 45° at 45°; heights 0.2 (px = mm ·
+  // scale, the scale from the first bead).
+  const double scale = r[0].w / 0.45;
+  EXPECT_NEAR(r[0].h / scale, 0.2, 0.01);
+  EXPECT_NEAR(r[1].w / scale, 0.45 * std::sqrt(2.0), 0.01);
+  // The second layer's bead at 45° crosses at x = 7, half-way up its rise: its top at 0.45.
+  EXPECT_NEAR((r[3].y - r[2].y) / scale, -0.05, 0.005);
+  EXPECT_NE(svg->find("1 curved layers (orange), 1 planar (blue)"), std::string::npos);
+}
+
+TEST(BeadSection, SaysWhenNothingCrossesThePlane) {
+  const PreviewBuffers b = preview_buffers(read_gcode_program(two_layers()), {}, PreviewParams{});
+  auto svg = bead_section_svg(b, nullptr, 'x', 50.0);
+  ASSERT_FALSE(svg);
+  EXPECT_EQ(svg.error().status, Status::invalid_argument);
+  EXPECT_NE(svg.error().message.find("no extrusion crosses x = 50"), std::string::npos);
+  EXPECT_FALSE(bead_section_svg(b, nullptr, 'z', 1.0));
 }
 
 }  // namespace
