@@ -96,7 +96,9 @@ Expected<PostProcessed> post_process_gcode(std::string_view gcode, const PrintPl
 
 /// The objects a G-code file's labels name (PrusaSlicer's comments, M486, Klipper's
 /// EXCLUDE_OBJECT_*), without the slicer's id, copy and file extension ("dome id:0 copy 0" is
-/// "dome"), in order of first appearance; empty without labels.
+/// "dome"), in order of first appearance; empty without labels. Bambu Lab's labels ("; start
+/// printing object, unique label id: N", OrcaSlicer's and Bambu Studio's) name none: post-process
+/// takes the one object of the plan's size as the part.
 std::vector<std::string> gcode_object_names(std::string_view gcode);
 
 /// The first line post_process_gcode writes (how a file already post-processed is known).

@@ -54,8 +54,12 @@ std::string object_name(std::string n) {
 // Object labels as the slicers write them: PrusaSlicer 2.5's "; printing object NAME id:0
 // copy 0" / "; stop printing object", 2.6+'s firmware labels M486 S<id> A"NAME" / M486 S-1
 // (a later M486 S<id> starts that object again), Klipper's EXCLUDE_OBJECT_START NAME=… /
-// EXCLUDE_OBJECT_END.
+// EXCLUDE_OBJECT_END, and for Bambu Lab printers (OrcaSlicer, Bambu Studio) "; start printing
+// object, unique label id: N" / "; stop printing object, unique label id: N", which name no
+// object: their start reads as kIdOnly + N, and only in a file with no named label (OrcaSlicer
+// writes both when asked for both).
 enum class Label { none, start, end };
+constexpr std::string_view kIdOnly = "label id ";
 class LabelReader {
  public:
   /// What line `raw` says; for a start, *name is the object's (object_name).
@@ -65,9 +69,16 @@ class LabelReader {
         {"; stop printing object", Label::end},
         {"EXCLUDE_OBJECT_START NAME=", Label::start},
         {"EXCLUDE_OBJECT_END", Label::end}};
+    constexpr std::string_view kIdStart = "; start printing object, unique label id: ";
+    if (raw.substr(0, kIdStart.size()) == kIdStart) {
+      if (named_) return Label::none;
+      *name = std::string(kIdOnly) + object_name(std::string(raw.substr(kIdStart.size(), 20)));
+      return Label::start;
+    }
     for (const auto& [head, kind] : kHeads)
       if (raw.substr(0, head.size()) == head) {
-        if (kind == Label::start) *name = object_name(std::string(raw.substr(head.size(), 200)));
+        if (kind == Label::start)
+          *name = object_name(std::string(raw.substr(head.size(), 200))), named_ = true;
         return kind;
       }
     if (raw.substr(0, 6) != "M486 S") return Label::none;
@@ -77,12 +88,13 @@ class LabelReader {
       names_[id] = object_name(std::string(raw.substr(a + 2, 200)));
     const auto it = names_.find(id);
     if (it == names_.end()) return Label::none;
-    *name = it->second;
+    *name = it->second, named_ = true;
     return Label::start;
   }
 
  private:
   std::map<long, std::string> names_;
+  bool named_ = false;  ///< a label with a name was read
 };
 
 // The part's outline in the slicer's words (PrusaSlicer's, OrcaSlicer's): supports and the
@@ -240,37 +252,82 @@ Expected<Vec2> placement(const GcodeProgram& prog, const std::vector<char>& ours
   return Vec2(0.5 * (b.min + b.max).head<2>() - 0.5 * (plan.box.min + plan.box.max).head<2>());
 }
 
+// Of labels that name no object (Bambu's ids): the one whose outline is the plan's size, as
+// placement measures it (empty: none or several).
+std::string sized_as_planned(const GcodeProgram& prog, const std::vector<int>& label_of_line,
+                             const std::vector<std::string>& names, const PrintPlan& plan) {
+  std::vector<BoundingBox> box(names.size());
+  for (const GcodeMove& m : prog.moves) {
+    const int k = m.line > 0 ? label_of_line[static_cast<std::size_t>(m.line - 1)] : -1;
+    if (k >= 0 && m.layer >= 0 && m.extruding() && outline(m.type))
+      box[static_cast<std::size_t>(k)].extend(m.from),
+          box[static_cast<std::size_t>(k)].extend(m.to);
+  }
+  const Vec2 want = plan.box.size().head<2>();
+  std::string found;
+  for (std::size_t k = 0; k < names.size(); ++k) {
+    if (box[k].empty()) continue;
+    const Vec2 got = box[k].size().head<2>();
+    if ((got.array() <= want.array() + 0.2).all() && (got.array() >= want.array() - 2.0).all()) {
+      if (!found.empty()) return {};
+      found = names[k];
+    }
+  }
+  return found;
+}
+
 // Whose each line is (LineOwner): with object labels naming several objects, a line between
 // another object's start and end labels is that object's (the labels too); else every line is
-// the part's or outside labels. Refused when the labels name several objects and none is the
+// the part's or outside labels. Labels that name no object (Bambu's ids): the part is the one
+// object of the plan's size. Refused when the labels name several objects and none is the
 // plan's.
 Expected<std::vector<char>> line_owners(const GcodeProgram& prog, const PrintPlan& plan) {
-  std::vector<char> owner(prog.lines.size(), kUnlabelled);
+  std::vector<int> label_of_line(prog.lines.size(), -1);
   std::vector<std::string> names;
-  std::string current, name;
+  std::string name;
+  int current = -1;
   LabelReader labels;
   for (std::size_t i = 0; i < prog.lines.size(); ++i) {
     const GcodeLine& l = prog.lines[i];
     const Label k = l.kind == GcodeLine::Kind::text ? labels.read(l.raw, &name) : Label::none;
     if (k == Label::start) {
-      current = name;
-      if (std::find(names.begin(), names.end(), name) == names.end()) names.push_back(name);
+      const auto it = std::find(names.begin(), names.end(), name);
+      current = static_cast<int>(it - names.begin());
+      if (it == names.end()) names.push_back(name);
     }
-    if (!current.empty()) owner[i] = current == plan.object ? kOurs : kOthers;
-    if (k == Label::end) current.clear();
+    label_of_line[i] = current;
+    if (k == Label::end) current = -1;
   }
+  std::vector<char> owner(prog.lines.size(), kUnlabelled);
   // One object on the plate is the planned one, whatever the user renamed it to.
   if (names.size() <= 1) {
-    for (char& o : owner)
-      if (o == kOthers) o = kOurs;
+    for (std::size_t i = 0; i < owner.size(); ++i)
+      if (label_of_line[i] >= 0) owner[i] = kOurs;
     return owner;
   }
-  if (std::find(names.begin(), names.end(), plan.object) == names.end()) {
+  std::string part = plan.object;
+  if (std::all_of(names.begin(), names.end(),
+                  [](const std::string& n) { return n.rfind(kIdOnly, 0) == 0; })) {
+    part = sized_as_planned(prog, label_of_line, names, plan);
+    if (part.empty()) {
+      char buf[320];
+      std::snprintf(buf, sizeof buf,
+                    "the plate's %zu objects are labelled by number only (Bambu Lab's labels), "
+                    "and not one alone has the plan's size (%.1f x %.1f mm): print it alone, "
+                    "or beside objects of another size",
+                    names.size(), plan.box.size().x(), plan.box.size().y());
+      return refuse(buf);
+    }
+  }
+  if (std::find(names.begin(), names.end(), part) == names.end()) {
     std::string list;
     for (const std::string& n : names) list += (list.empty() ? "" : ", ") + n;
     return refuse("the plate's objects are " + list + "; none is " + plan.object +
                   ", the plan's (keep the name prepare gave it)");
   }
+  for (std::size_t i = 0; i < owner.size(); ++i)
+    if (label_of_line[i] >= 0)
+      owner[i] = names[static_cast<std::size_t>(label_of_line[i])] == part ? kOurs : kOthers;
   return owner;
 }
 
@@ -371,7 +428,7 @@ std::vector<std::string> gcode_object_names(std::string_view gcode) {
     const char c = gcode[at];
     if ((c == ';' || c == 'M' || c == 'E') &&
         labels.read(gcode.substr(at, end - at), &name) == Label::start &&
-        std::find(names.begin(), names.end(), name) == names.end())
+        name.rfind(kIdOnly, 0) != 0 && std::find(names.begin(), names.end(), name) == names.end())
       names.push_back(name);
     at = end + 1;
   }

@@ -185,15 +185,16 @@ TEST(PostProcessRoute, SupportsAndBrimFollow) {
   EXPECT_EQ(figures(engine, dir / "perched.stl")["collisions"], 0);
 }
 
-// The cube's extrusions inside its labels, without their E (the writer rounds E the same way,
-// but the point is where the nozzle goes).
-std::vector<std::string> lines_of_object(const std::string& text, const std::string& name) {
+// The extrusions between a line starting `start` and one starting `stop`, without their E (the
+// writer rounds E the same way, but the point is where the nozzle goes).
+std::vector<std::string> lines_between(const std::string& text, const std::string& start,
+                                       const std::string& stop) {
   std::vector<std::string> out;
   bool in = false;
   std::stringstream ss(text);
   for (std::string l; std::getline(ss, l);) {
-    if (l.rfind("; printing object " + name, 0) == 0) in = true;
-    if (l.rfind("; stop printing object " + name, 0) == 0) in = false;
+    if (l.rfind(start, 0) == 0) in = true;
+    if (l.rfind(stop, 0) == 0) in = false;
     if (!in || l.rfind("G1 X", 0) != 0 || l.find(" E") == std::string::npos) continue;
     std::stringstream w(l.substr(0, l.find(" E")));
     double x, y;
@@ -205,6 +206,11 @@ std::vector<std::string> lines_of_object(const std::string& text, const std::str
     out.push_back(buf);
   }
   return out;
+}
+
+// An object's extrusions inside its PrusaSlicer labels.
+std::vector<std::string> lines_of_object(const std::string& text, const std::string& name) {
+  return lines_between(text, "; printing object " + name, "; stop printing object " + name);
 }
 
 // A plate of the prepared part and another object: with object labels the other one is left
@@ -235,6 +241,70 @@ TEST(PostProcessRoute, OtherObjectsOnThePlateAreLeftAlone) {
   const auto u = test::run_cli("post-process --plan " + plan.string() + " " + out.string());
   EXPECT_EQ(u.code, 2);
   EXPECT_NE(u.err.find("switch on Label objects"), std::string::npos) << u.err;
+}
+
+// PrusaSlicer's labels rewritten as a Bambu Lab printer's (OrcaSlicer, Bambu Studio): "; start
+// printing object, unique label id: N" and an M624 mask / "; stop printing object, unique label
+// id: N" and M625, no names.
+std::string bambu_labels(const std::string& text) {
+  std::string out;
+  std::stringstream ss(text);
+  std::map<std::string, int> ids;
+  for (std::string l; std::getline(ss, l);) {
+    if (l.rfind("; printing object ", 0) == 0) {
+      const int id = ids.emplace(l.substr(18), static_cast<int>(ids.size()) + 1).first->second;
+      out += "; start printing object, unique label id: " + std::to_string(id) +
+             "\nM624 AQAAAAAAAAA=\n";
+    } else if (l.rfind("; stop printing object ", 0) == 0) {
+      const int id = ids.at(l.substr(23));
+      out += "; stop printing object, unique label id: " + std::to_string(id) + "\nM625\n";
+    } else {
+      out += l + "\n";
+    }
+  }
+  return out;
+}
+
+// Labels without names: the part is the one object of the plan's size; two of that size are
+// refused, naming why.
+TEST(PostProcessRoute, BambuLabelsFindThePartBySize) {
+  if (!have_prusaslicer()) GTEST_SKIP() << "prusa-slicer not installed";
+  const fs::path dir = test::temp_dir("pp_bambu");
+  const fs::path plan = prepared(dir, "dome", test::dome_cut_by_box());
+  for (const double side : {15.0, 24.0}) {
+    ASSERT_TRUE(write_stl(dir / "cube.stl", test::box({0, 0, 0}, {side, side, 6})));
+    const fs::path out = dir / "plate.gcode";
+    ASSERT_EQ(prusa("--export-gcode --first-layer-height 0.2 --gcode-label-objects -o " +
+                    out.string() + " --merge " + plan.string() + " " + (dir / "cube.stl").string()),
+              0);
+    const std::string before = test::read_bytes(out);
+    test::write_bytes(out, bambu_labels(before));
+    const auto r = test::run_cli("post-process --plan " + plan.string() + " " + out.string());
+    if (side == 24.0) {  // the dome's box is 24 x 24 mm too
+      EXPECT_EQ(r.code, 2);
+      EXPECT_NE(r.err.find("labelled by number only (Bambu Lab's labels)"), std::string::npos)
+          << r.err;
+      continue;
+    }
+    ASSERT_EQ(r.code, 0) << r.err;
+    // The cube's lines as written, the dome's mapped.
+    const std::string after = test::read_bytes(out), labelled = bambu_labels(before);
+    const auto cube = lines_of_object(before, "cube");
+    ASSERT_GT(cube.size(), 100u);
+    int kept = 0;
+    for (const char* id : {"1", "2"}) {
+      const std::string start = std::string("; start printing object, unique label id: ") + id,
+                        stop = std::string("; stop printing object, unique label id: ") + id;
+      const auto now = lines_between(after, start, stop);
+      if (now != lines_between(labelled, start, stop)) continue;
+      ++kept;
+      EXPECT_EQ(now, cube);
+    }
+    EXPECT_EQ(kept, 1);
+    const auto f = figures(out, dir / "dome.stl");
+    EXPECT_EQ(f["collisions"], 0);
+    EXPECT_LE(f["top_surface_deviation"]["p95"].get<double>(), 0.02);
+  }
 }
 
 // The plan checked with PrusaSlicer's own paths for the user's presets (here the stock MK3S's),

@@ -263,6 +263,10 @@ TEST(PostProcess, ObjectLabelsNameTheParts) {
                                "EXCLUDE_OBJECT_START NAME=dome_id_0_copy_0\nEXCLUDE_OBJECT_END\n"),
             (std::vector<std::string>{"dome"}));
   EXPECT_TRUE(gcode_object_names("G1 X1 ; printing object dome\n").empty());
+  // Bambu Lab's labels give numbers, not names.
+  EXPECT_TRUE(gcode_object_names("; start printing object, unique label id: 5\nM624 AQAAAAAAAAA=\n"
+                                 "G1 X1\n; stop printing object, unique label id: 5\nM625\n")
+                  .empty());
   // post-process: one labelled object is the plan's whatever its name; of several, one must be.
   const Prepared& d = dome();
   const std::string g = sliced(d.part.normalized);
