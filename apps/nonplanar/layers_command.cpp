@@ -102,6 +102,17 @@ int run(const LayersOptions& o) {
     if (auto w = write_section_svg(o.section, loaded->mesh, *plan, at.axis, at.value); !w)
       return report_error(w.error());
 
+  // What `slice` does then: a shell, or shells beside the stacks (it also plans the stacks
+  // again on the core's layers and runs the safety check on the result).
+  // (Stacks over less than half the curved area: a shell over all the patches is tried first.)
+  std::vector<int> stacked;
+  double curved = 0, stacked_area = 0;
+  for (const Patch& q : analysis->patches) curved += q.needs_nonplanar() ? q.area : 0;
+  for (const LayerStack& st : plan->stacks)
+    stacked.push_back(st.patch),
+        stacked_area += analysis->patches[static_cast<std::size_t>(st.patch)].area;
+  if (curved > 2 * stacked_area) stacked.clear();
+  const ShellSummary sh = summarize_shell(loaded->mesh, *analysis, lp, stacked);
   if (o.json) {
     nlohmann::ordered_json j;
     j["file"] = o.mesh.model;
@@ -130,17 +141,12 @@ int run(const LayersOptions& o) {
     for (const auto& f : plan->fallbacks) fb.push_back({{"patch", f.patch}, {"reason", f.reason}});
     j["planar_fallbacks"] = std::move(fb);
     if (!o.export_normalized.empty()) j["normalized_edges_split"] = split;
-    if (plan->stacks.empty()) {
-      const ShellSummary sh = summarize_shell(loaded->mesh, *analysis, lp);
-      if (!sh.patches.empty())
-        j["shell"] = {{"patches", sh.patches},
-                      {"shells", sh.shells},
-                      {"layers", sh.layers},
-                      {"thickness", sh.thickness},
-                      {"core_layers", sh.core_layers}};
-      else
-        j["shell"] = {{"refused", sh.refused}};
-    }
+    if (!sh.patches.empty())
+      j["shell"] = {{"patches", sh.patches},         {"shells", sh.shells},
+                    {"layers", sh.layers},           {"thickness", sh.thickness},
+                    {"core_layers", sh.core_layers}, {"beside_stacks", !stacked.empty()}};
+    else if (!sh.refused.empty())
+      j["shell"] = {{"refused", sh.refused}};
     std::printf("%s\n", j.dump(2).c_str());
     return kExitOk;
   }
@@ -155,19 +161,16 @@ int run(const LayersOptions& o) {
         st.max_block_rise, st.cost_before, st.cost_after, st.iterations);
   for (const auto& f : plan->fallbacks)
     std::printf("  patch %d planar: %s\n", f.patch, f.reason.c_str());
-  if (plan->stacks.empty()) {
-    // What `slice` does then (it also runs the safety check on the result).
-    const ShellSummary sh = summarize_shell(loaded->mesh, *analysis, lp);
-    std::string list;
-    for (int p : sh.patches) list += (list.empty() ? "" : ", ") + std::to_string(p);
-    if (!sh.patches.empty())
-      std::printf("  %s: patch%s %s as %d curved layers of %.2f mm over %zu planar core layers\n",
-                  sh.shells > 1 ? (std::to_string(sh.shells) + " shells").c_str() : "shell",
-                  sh.patches.size() == 1 ? "" : "es", list.c_str(), sh.layers, sh.thickness,
-                  sh.core_layers);
-    else
-      std::printf("  no shell: %s\n", sh.refused.c_str());
-  }
+  const char* beside = stacked.empty() ? "" : " beside the stacks";
+  std::string list;
+  for (int p : sh.patches) list += (list.empty() ? "" : ", ") + std::to_string(p);
+  if (!sh.patches.empty())
+    std::printf("  %s%s: patch%s %s as %d curved layers of %.2f mm over %zu planar core layers\n",
+                sh.shells > 1 ? (std::to_string(sh.shells) + " shells").c_str() : "shell", beside,
+                sh.patches.size() == 1 ? "" : "es", list.c_str(), sh.layers, sh.thickness,
+                sh.core_layers);
+  else if (!sh.refused.empty())
+    std::printf("  no shell%s: %s\n", beside, sh.refused.c_str());
   return kExitOk;
 }
 

@@ -159,6 +159,9 @@ Expected<void> write_section_svg(const std::filesystem::path& file, const Triang
 
 /// What `slice` prints when plan_layers builds no stack but the part's whole top is curved: a
 /// shell of curved layers over a planar core (src/layers/shell_plan.hpp; README), or why not.
+/// With `stacked` (the stacks' patches): the shells beside them over the curved patches they
+/// leave (none and no reason when those are under 5 % of the curved area); slice then plans
+/// the stacks again on the core's layers and checks the two together.
 struct ShellSummary {
   std::vector<int> patches;  ///< the patches the shells follow; empty: no shell
   int shells = 0;            ///< one per curved region the part stands above (choose_shells)
@@ -167,7 +170,8 @@ struct ShellSummary {
   std::size_t core_layers = 0;
   std::string refused;  ///< why not (empty when there is a shell)
 };
-ShellSummary summarize_shell(const TriangleMesh& mesh, const Analysis& a, const LayerParams& p);
+ShellSummary summarize_shell(const TriangleMesh& mesh, const Analysis& a, const LayerParams& p,
+                             const std::vector<int>& stacked = {});
 
 /// A planar-only field (first layer h₁, then h).
 std::shared_ptr<const LayerField> planar_field(const LayerParams& params);

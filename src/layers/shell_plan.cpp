@@ -372,16 +372,52 @@ std::vector<ShellPlan> choose_shells(const TriangleMesh& mesh, const Analysis& a
   return shells;
 }
 
+std::vector<ShellPlan> choose_shells_beside(const TriangleMesh& mesh, const Analysis& a,
+                                            const LayerParams& p, const std::vector<int>& stacked,
+                                            std::vector<int>& rest, std::string& why) {
+  rest.clear(), why.clear();
+  double curved = 0, left = 0;
+  for (int i : curved_among(a, {})) {
+    const double area = a.patches[static_cast<std::size_t>(i)].area;
+    curved += area;
+    if (std::find(stacked.begin(), stacked.end(), i) == stacked.end())
+      rest.push_back(i), left += area;
+  }
+  // Too little left to be worth a core of thinner layers (h_c) under the whole part.
+  constexpr double kLeast = 0.05;
+  if (rest.empty() || left < kLeast * curved) return rest.clear(), std::vector<ShellPlan>{};
+  ShellChoice c;
+  c.among = rest, c.even_core = true;
+  std::vector<ShellPlan> shells = choose_shells(mesh, a, p, c);
+  const ShellPlan& first = shells.front();
+  if (!first.refused.empty())
+    why = first.refused;
+  else if (first.core.size() < 3)
+    why = "no room for a core under it";
+  else if (std::any_of(shells.begin(), shells.end(),
+                       [](const ShellPlan& s) { return s.region.empty(); }))
+    why = "the part stands nowhere above it, so it would cover the stacks too";
+  if (!why.empty()) shells.clear();
+  return shells;
+}
+
 }  // namespace nonplanar::layers
 
 namespace nonplanar {
 
-ShellSummary summarize_shell(const TriangleMesh& mesh, const Analysis& a, const LayerParams& p) {
-  const std::vector<layers::ShellPlan> plans = layers::choose_shells(mesh, a, p);
-  const layers::ShellPlan& plan = plans.front();
+ShellSummary summarize_shell(const TriangleMesh& mesh, const Analysis& a, const LayerParams& p,
+                             const std::vector<int>& stacked) {
   ShellSummary s;
-  s.refused = plan.refused;
-  if (!plan.refused.empty()) return s;
+  std::vector<layers::ShellPlan> plans;
+  if (stacked.empty()) {
+    plans = layers::choose_shells(mesh, a, p);
+    s.refused = plans.front().refused;
+  } else {
+    std::vector<int> rest;
+    plans = layers::choose_shells_beside(mesh, a, p, stacked, rest, s.refused);
+  }
+  if (plans.empty() || !s.refused.empty()) return s;
+  const layers::ShellPlan& plan = plans.front();
   for (const layers::ShellPlan& q : plans) {
     s.patches.insert(s.patches.end(), q.patches.begin(), q.patches.end());
     s.layers = std::max(s.layers, q.N);

@@ -106,6 +106,16 @@ struct ShellChoice {
 std::vector<ShellPlan> choose_shells(const TriangleMesh& mesh, const Analysis& a,
                                      const LayerParams& p, const ShellChoice& c);
 
+/// The shells beside stacks (`stacked`: their patches): over the curved patches the stacks
+/// leave, when those are 5 % of the curved area or more, on an even core, each printing only
+/// where the part stands nowhere above it (a shell over the whole part would cut the stacks
+/// away). `rest` gets those patches (empty: none left, or too little: no shells and no reason);
+/// `why` why there are none (empty shells). The caller plans the stacks again on the core's
+/// layers and checks that no shell cuts the core inside their bands.
+std::vector<ShellPlan> choose_shells_beside(const TriangleMesh& mesh, const Analysis& a,
+                                            const LayerParams& p, const std::vector<int>& stacked,
+                                            std::vector<int>& rest, std::string& why);
+
 /// The shell's layer field: T = N + (z − H)/t, ζ = base + t·T, so the normalised mesh holds
 /// the shell's layers as planes ζ = base + j·t … base + (j + 1)·t. Every column is curved.
 /// base (mm) lifts the normalised shell: 0 for a slab on the bed (an engine's run of its

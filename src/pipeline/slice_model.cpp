@@ -394,17 +394,13 @@ Expected<std::optional<SliceResult>> shells_beside_stacks(const TriangleMesh& me
   if (job.engine.engine != Engine::builtin || job.one_run_shells || stacked.plan.stacks.empty())
     return none;
   const std::vector<int> stacked_ids = stacked_patches(stacked.plan);
-  std::vector<int> rest, curved;
-  for (std::size_t i = 0; i < a.patches.size(); ++i) {
-    if (!a.patches[i].needs_nonplanar()) continue;
-    curved.push_back(static_cast<int>(i));
-    if (std::find(stacked_ids.begin(), stacked_ids.end(), static_cast<int>(i)) == stacked_ids.end())
-      rest.push_back(static_cast<int>(i));
-  }
-  // Too little left to be worth a core of thinner layers (h_c) under the whole part.
-  constexpr double kLeast = 0.05;
-  if (rest.empty() || area_of(a, rest) < kLeast * area_of(a, curved)) return none;
-  ctx.progress("shell", 0);
+  std::vector<int> rest;
+  std::string refused;
+  const auto curved = std::count_if(a.patches.begin(), a.patches.end(),
+                                    [](const Patch& q) { return q.needs_nonplanar(); });
+  if (static_cast<std::size_t>(curved) > stacked_ids.size()) ctx.progress("shell", 0);
+  std::vector<layers::ShellPlan> shells =
+      layers::choose_shells_beside(mesh, a, job.layers, stacked_ids, rest, refused);
   // Why not, said of the patches left planar (the run's summary gives the first reason).
   auto not_beside = [&](const std::string& why) {
     stacked.notices.push_back(
@@ -412,15 +408,9 @@ Expected<std::optional<SliceResult>> shells_beside_stacks(const TriangleMesh& me
          patch_names(rest) + " not printed as a shell beside the stacks: " + why});
     return none;
   };
-  layers::ShellChoice choice;
-  choice.among = rest, choice.even_core = true;
-  std::vector<layers::ShellPlan> shells = layers::choose_shells(mesh, a, job.layers, choice);
+  if (rest.empty()) return none;
+  if (shells.empty()) return not_beside(refused);
   const layers::ShellPlan& first = shells.front();
-  if (!first.refused.empty()) return not_beside(first.refused);
-  if (first.core.size() < 3) return not_beside("no room for a core under it");
-  for (const layers::ShellPlan& sh : shells)
-    if (sh.region.empty())
-      return not_beside("the part stands nowhere above it, so it would cover the stacks too");
   LayerParams on_core = job.layers;
   on_core.first_layer_height = first.core[1];
   on_core.layer_height = first.core[2] - first.core[1];

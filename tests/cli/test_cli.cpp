@@ -139,6 +139,26 @@ TEST(Cli, LayersAndSliceReportTheShell) {
             std::string::npos);
 }
 
+// A stack and a shell in one part: `layers` names the shell beside the stack, `slice` prints both.
+TEST(Cli, LayersAndSliceReportAShellBesideAStack) {
+  const auto dir = test::temp_dir("cli_beside");
+  ASSERT_TRUE(write_stl(dir / "p.stl", test::rib_and_domed_tower()));
+  const CliResult r = run("layers -q " + (dir / "p.stl").string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("1 curved stack,"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("shell beside the stacks: patch 1 as 4 curved layers"), std::string::npos)
+      << r.out;
+  const CliResult s =
+      run("slice " + (dir / "p.stl").string() + " -o " + (dir / "p.gcode").string());
+  ASSERT_EQ(s.code, 0) << s.err;
+  EXPECT_NE(s.err.find("patch 1: curved shell over a planar core (1 curved stack beside it)"),
+            std::string::npos)
+      << s.err;
+  const std::string g = test::read_bytes(dir / "p.gcode");
+  EXPECT_NE(g.find("; patch 1: a shell of 4 curved layers"), std::string::npos);
+  EXPECT_NE(g.find("; patch 0: "), std::string::npos);
+}
+
 TEST(Cli, SlicePlanarWritesGcodeAndRefusesBadSettings) {
   const auto dir = test::temp_dir("cli_slice");
   ASSERT_TRUE(write_stl(dir / "c.stl", test::box({0, 0, 0}, {20, 20, 10})));
