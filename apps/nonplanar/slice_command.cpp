@@ -7,6 +7,7 @@
 #include "commands.hpp"
 #include "nonplanar/gcode.hpp"
 #include "nonplanar/pipeline.hpp"
+#include "nonplanar/print_plan.hpp"
 #include "nonplanar/unsupported_keys.hpp"
 #include "preview_command.hpp"
 #include "stage_timer.hpp"
@@ -124,6 +125,12 @@ int run(const SliceOptions& o) {
   job.planar_only = o.planar;
   job.engine = engine;
   job.header.push_back("model: " + o.mesh.model);
+  {  // where check and preview find the part, whatever printer the file was sliced for
+    char buf[120];
+    std::snprintf(buf, sizeof buf, "%.3f, %.3f mm on the bed", 0.5 * (box.min.x() + box.max.x()),
+                  0.5 * (box.min.y() + box.max.y()));
+    job.header.push_back(std::string(kPartCentredAt.substr(2)) + buf);
+  }
   if (loaded->objects.several()) {
     // A 3MF's build items, where it placed them: each layer prints them one by one, each
     // with its own label. Another slicer gets the normalised part as one object, and so does

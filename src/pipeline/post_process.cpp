@@ -396,18 +396,21 @@ Expected<EngineShell> map_shell_gcode(ShellSplit& sp, const Vec2& moved, const S
                     "the shell's curved layers, from the slicer's layers above the core", ctx);
 }
 
-// Whether our mark heads our header, which the time estimate's first M73 lines may precede (a
-// profile with remaining_times, as the MK3S's): looked for before the first layer.
-bool post_processed(std::string_view gcode) {
+// Whether a mark of ours heads our header, which the time estimate's first M73 lines may
+// precede (a profile with remaining_times, as the MK3S's): looked for before the first layer.
+bool marked(std::string_view gcode, std::string_view mark) {
   const std::string_view head = gcode.substr(0, gcode.find("\n;LAYER_CHANGE"));
-  return head.substr(0, kPostProcessedMark.size()) == kPostProcessedMark ||
-         head.find("\n" + std::string(kPostProcessedMark)) != std::string_view::npos;
+  return head.substr(0, mark.size()) == mark ||
+         head.find("\n" + std::string(mark)) != std::string_view::npos;
+}
+bool post_processed(std::string_view gcode) {
+  return marked(gcode, kPostProcessedMark);
 }
 
 }  // namespace
 
 std::optional<Vec2> post_processed_centre(std::string_view gcode) {
-  if (!post_processed(gcode)) return std::nullopt;
+  if (!post_processed(gcode) && !marked(gcode, kGeneratedMark)) return std::nullopt;
   const std::string_view head = gcode.substr(0, gcode.find("\n;LAYER_CHANGE"));
   const std::size_t at = head.find(kPartCentredAt);
   double x = 0, y = 0;

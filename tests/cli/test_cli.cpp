@@ -241,16 +241,24 @@ TEST(Cli, CheckReadsTheBedFromTheFilesSettingsBlock) {
   const std::string block =
       "; prusaslicer_config = begin\n; bed_shape = 0x0,250x0,250x210,0x210\n"
       "; layer_height = 0.2\n; prusaslicer_config = end\n";
-  EXPECT_GT(outside(gcode, ""), 0.3);                // placed at (110, 110): 15 mm off
-  EXPECT_LT(outside(gcode + block, ""), 0.01);       // the block's bed: centred at (125, 105)
-  EXPECT_LT(outside(gcode, " --set " + bed), 0.01);  // or the user's
-  const std::string orca =                           // OrcaSlicer's block and key name
+  // Our own file's header says where the part is: placed there with no block or setting.
+  EXPECT_NE(gcode.find("; the part's box centred at 125.000, 105.000 mm on the bed\n"),
+            std::string::npos);
+  EXPECT_LT(outside(gcode, ""), 0.01);
+  // Without that line (another slicer's file), the bed from the block or the user.
+  std::string bare = gcode;
+  const auto at = bare.find("; the part's box centred at");
+  bare.erase(at, bare.find('\n', at) + 1 - at);
+  EXPECT_GT(outside(bare, ""), 0.3);                // placed at (110, 110): 15 mm off
+  EXPECT_LT(outside(bare + block, ""), 0.01);       // the block's bed: centred at (125, 105)
+  EXPECT_LT(outside(bare, " --set " + bed), 0.01);  // or the user's
+  const std::string orca =                          // OrcaSlicer's block and key name
       "; CONFIG_BLOCK_START\n; printable_area = 0x0,250x0,250x210,0x210\n; CONFIG_BLOCK_END\n";
-  EXPECT_LT(outside(gcode + orca, ""), 0.01);
+  EXPECT_LT(outside(bare + orca, ""), 0.01);
   const std::string wrong =
       "; prusaslicer_config = begin\n; bed_shape = 0x0,1x0\n"
       "; prusaslicer_config = end\n";
-  test::write_bytes(dir / "w.gcode", gcode + wrong);
+  test::write_bytes(dir / "w.gcode", bare + wrong);
   const CliResult n = run("check " + (dir / "w.gcode").string() + " --mesh " + model);
   EXPECT_EQ(n.code, 0) << n.err;  // a block that does not read: a notice, and the defaults
   EXPECT_NE(n.err.find("w.gcode: its settings block is not used: "), std::string::npos) << n.err;
