@@ -419,8 +419,13 @@ Expected<std::optional<SliceResult>> shells_beside_stacks(const TriangleMesh& me
   for (std::size_t i = 0; i < pre.ids.size(); ++i)
     if (std::find(stacked_ids.begin(), stacked_ids.end(), pre.ids[i]) != stacked_ids.end())
       fits.push_back(pre.fits[i]), ids.push_back(pre.ids[i]);
+  // The stacks already print: an error on the way (but Ctrl-C) leaves them as they are.
+  auto failed = [&](const Error& e) -> Expected<std::optional<SliceResult>> {
+    if (e.status == Status::cancelled) return e;
+    return not_beside(e.message);
+  };
   auto plan = plan_layers(mesh, a, fits, ids, on_core, ctx);
-  if (!plan) return plan.error();
+  if (!plan) return failed(plan.error());
   const auto* banded = dynamic_cast<const layers::BandedField*>(plan->field.get());
   char buf[200];
   if (plan->stacks.size() != stacked_ids.size() || !banded) {
@@ -437,8 +442,10 @@ Expected<std::optional<SliceResult>> shells_beside_stacks(const TriangleMesh& me
   const std::string why = std::to_string(plan->stacks.size()) +
                           (plan->stacks.size() == 1 ? " curved stack" : " curved stacks") +
                           " beside it";
-  return try_shell(
+  auto both = try_shell(
       mesh, job, shells, why, stacked, [] {}, ctx, &*plan);
+  if (!both) return failed(both.error());
+  return both;
 }
 
 }  // namespace
