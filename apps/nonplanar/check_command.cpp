@@ -9,7 +9,6 @@
 #include "core/file_bytes.hpp"
 #include "nonplanar/check.hpp"
 #include "nonplanar/gcode.hpp"
-#include "nonplanar/print_plan.hpp"
 
 namespace nonplanar::cli {
 namespace {
@@ -44,15 +43,7 @@ int run(const CheckOptions& o) {
   if (!moves)
     return finish_progress(),
            report_error({moves.error().status, o.gcode + ": " + moves.error().message});
-  LoadParams lp = o.mesh.load;
-  lp.bed_center = cfg->bed_center();
-  // A file post-process mapped says where the slicer put the part (moved, on a plate).
-  if (const auto centre = post_processed_centre(bytes->view())) {
-    if (!(o.mesh.quiet || o.json) && (*centre - lp.bed_center).norm() > 1e-3)
-      std::fprintf(stderr, "the mesh centred at %.3f, %.3f mm, where the file's header puts it\n",
-                   centre->x(), centre->y());
-    lp.bed_center = *centre;
-  }
+  const LoadParams lp = o.mesh.placed_like(bytes->view(), *cfg, o.mesh.quiet || o.json);
   auto mesh = load_mesh(o.mesh.model, lp, ctx);
   if (!mesh) return finish_progress(), report_error(mesh.error());
   auto f = check_print(*moves, &mesh->mesh, params, ctx);

@@ -17,6 +17,7 @@
 #include "core/sanitizers.hpp"
 #include "engine/external_engine.hpp"
 #include "nonplanar/macros.hpp"
+#include "nonplanar/print_plan.hpp"
 #include "nonplanar/unsupported_keys.hpp"
 
 namespace nonplanar::cli {
@@ -128,6 +129,19 @@ void MeshOptions::add_to(CLI::App& cmd) {
   cmd.add_option("--rotate-y", load.rotate_y_deg, "Rotate about Y (degrees)");
   cmd.add_option("--rotate-z", load.rotate_z_deg, "Rotate about Z (degrees)");
   cmd.add_flag("-q,--quiet", quiet, "No progress or warnings on stderr");
+}
+
+LoadParams MeshOptions::placed_like(std::string_view gcode, const PrintConfig& cfg,
+                                    bool quiet_here) const {
+  LoadParams lp = load;
+  lp.bed_center = cfg.bed_center();
+  if (const auto centre = post_processed_centre(gcode)) {
+    if (!quiet_here && (*centre - lp.bed_center).norm() > 1e-3)
+      std::fprintf(stderr, "the mesh centred at %.3f, %.3f mm, where the file's header puts it\n",
+                   centre->x(), centre->y());
+    lp.bed_center = *centre;
+  }
+  return lp;
 }
 
 void PresetOptions::add_to(CLI::App& cmd) {

@@ -45,6 +45,10 @@ struct MeshOptions {
   LoadParams load;
   bool quiet = false;
   void add_to(CLI::App& cmd);
+  /// How to load the mesh a G-code file was sliced from, placed where that file has it: the
+  /// centre its header gives (post_processed_centre: files post-process or slice wrote), else
+  /// the bed centre of `cfg`. Says so on stderr (unless `quiet`) when the two differ.
+  LoadParams placed_like(std::string_view gcode, const PrintConfig& cfg, bool quiet) const;
 };
 
 /// Presets by name from a vendor bundle (--printer-profile, --print-profile,

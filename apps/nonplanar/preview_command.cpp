@@ -13,7 +13,6 @@
 #include "nonplanar/check.hpp"
 #include "nonplanar/gcode.hpp"
 #include "nonplanar/pipeline.hpp"
-#include "nonplanar/print_plan.hpp"
 
 namespace nonplanar::cli {
 
@@ -104,10 +103,7 @@ int run(const PreviewOptions& o) {
   LoadedMesh loaded;
   if (!o.section.empty()) {
     if (!o.mesh.model.empty()) {
-      LoadParams lp = o.mesh.load;
-      lp.bed_center = cfg->bed_center();
-      if (const auto centre = post_processed_centre(bytes->view())) lp.bed_center = *centre;
-      auto m = load_mesh(o.mesh.model, lp, ctx);
+      auto m = load_mesh(o.mesh.model, o.mesh.placed_like(bytes->view(), *cfg, o.mesh.quiet), ctx);
       finish_progress();
       if (!m) return report_error(m.error());
       loaded = std::move(*m);
@@ -119,9 +115,7 @@ int run(const PreviewOptions& o) {
     // read is an error here too).
     auto moves = read_gcode_moves(bytes->view());
     if (!moves) return report_error({moves.error().status, o.gcode + ": " + moves.error().message});
-    LoadParams lp = o.mesh.load;
-    lp.bed_center = cfg->bed_center();
-    auto m = load_mesh(o.mesh.model, lp, ctx);
+    auto m = load_mesh(o.mesh.model, o.mesh.placed_like(bytes->view(), *cfg, o.mesh.quiet), ctx);
     if (!m) return finish_progress(), report_error(m.error());
     loaded = std::move(*m);
     auto f = check_print(*moves, &loaded.mesh, check_params(*cfg, o.max_angle), ctx);

@@ -365,10 +365,10 @@ Expected<Samples> sample_extrusions(const MoveReplay& moves) {
   return s;
 }
 
-// Collisions, in print order, among the points `looked_at` accepts (null: all).
 constexpr double kTravelStep = 0.5;  ///< mm between the points of a travel looked at
 constexpr double kUnderBed = 0.01;   ///< mm: a move lower than this under z = 0 hits the bed
 
+// Collisions, in print order, among the points `looked_at` accepts (null: all).
 Expected<CollisionFigures> search_collisions(const MoveReplay& moves, const Samples& s,
                                              const CheckParams& cp,
                                              const std::function<bool(const Vec3&)>& looked_at,

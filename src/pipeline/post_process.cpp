@@ -219,6 +219,12 @@ std::optional<Vec2> anchored(const GcodeProgram& prog, const std::vector<char>& 
   return Vec2(centroid(best, &unused) - want);
 }
 
+// Whether an outline's box (XY, mm) is the plan's size: perimeters lie half a width inside the
+// part, and a part is never wider than itself.
+bool planned_size(const Vec2& got, const Vec2& want) {
+  return (got.array() <= want.array() + 0.2).all() && (got.array() >= want.array() - 2.0).all();
+}
+
 // Where the slicer put the part: the box of its outline (its outer perimeters; without any,
 // every extrusion of the part) against the plan's. A part keeps its size when only moved;
 // scaled, rotated, or with other objects on the plate, the box's size differs.
@@ -236,18 +242,16 @@ Expected<Vec2> placement(const GcodeProgram& prog, const std::vector<char>& ours
   }
   if (b.empty()) return refuse("the file extrudes nothing but skirt, brim and supports");
   const Vec2 got = b.size().head<2>(), want = plan.box.size().head<2>();
-  // Perimeters lie half a width inside the part; a part is never wider than itself.
-  for (int k = 0; k < 2; ++k)
-    if (got[k] > want[k] + 0.2 || got[k] < want[k] - 2.0) {
-      char buf[320];
-      std::snprintf(buf, sizeof buf,
-                    "the part in the G-code is %.1f x %.1f mm, the plan's %.1f x %.1f mm: it was "
-                    "scaled or rotated after prepare (move it, but do not scale or rotate it), "
-                    "or the plate holds other objects (switch on Label objects, Print Settings > "
-                    "Output options, so post-process can tell them apart)",
-                    got.x(), got.y(), want.x(), want.y());
-      return refuse(buf);
-    }
+  if (!planned_size(got, want)) {
+    char buf[320];
+    std::snprintf(buf, sizeof buf,
+                  "the part in the G-code is %.1f x %.1f mm, the plan's %.1f x %.1f mm: it was "
+                  "scaled or rotated after prepare (move it, but do not scale or rotate it), "
+                  "or the plate holds other objects (switch on Label objects, Print Settings > "
+                  "Output options, so post-process can tell them apart)",
+                  got.x(), got.y(), want.x(), want.y());
+    return refuse(buf);
+  }
   if (auto at = anchored(prog, ours, plan)) return *at;
   return Vec2(0.5 * (b.min + b.max).head<2>() - 0.5 * (plan.box.min + plan.box.max).head<2>());
 }
@@ -267,8 +271,7 @@ std::string sized_as_planned(const GcodeProgram& prog, const std::vector<int>& l
   std::string found;
   for (std::size_t k = 0; k < names.size(); ++k) {
     if (box[k].empty()) continue;
-    const Vec2 got = box[k].size().head<2>();
-    if ((got.array() <= want.array() + 0.2).all() && (got.array() >= want.array() - 2.0).all()) {
+    if (planned_size(box[k].size().head<2>(), want)) {
       if (!found.empty()) return {};
       found = names[k];
     }
