@@ -48,6 +48,13 @@ Expected<LoadedMesh> load_mesh(const std::filesystem::path& file, const LoadPara
 /// Binary STL writer (used by tests, benchmarks and later stages). Atomic.
 Expected<void> write_stl(const std::filesystem::path& file, const TriangleMesh& mesh);
 
+/// The mesh as Wavefront OBJ text, as a binary STL of it would reach a slicer: coordinates
+/// rounded to float (written as that float's exact value read as a double), vertices
+/// shared where their floats are equal (in order of first use by the faces), faces whose
+/// corners collapse to one point or an edge left out (counted in *collapsed if given). For a
+/// reader that cannot seek (a pipe: PrusaSlicer reads an STL with fseek, an OBJ front to back).
+std::string obj_text(const TriangleMesh& mesh, std::size_t* collapsed = nullptr);
+
 /// A file stored beside the model in a 3MF package: its path in the package ("/Metadata/…")
 /// and its bytes.
 struct PackageFile {

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "engine/external_engine.hpp"
 #include "layers/shell_plan.hpp"
 #include "nonplanar/config.hpp"
 #include "nonplanar/deform.hpp"
@@ -21,6 +22,9 @@ struct EngineRoute {
   const PrintConfig& print;
   const LayerParams& layers;
   const MapBackParams& map_back;
+  /// PrusaSlicer started before the mesh existed (start_engine_early): the first plain run of
+  /// a mesh where it expects one takes it. Null: each run starts its own.
+  EarlyEngine* early = nullptr;
 };
 
 /// A sliced part: its layers mapped back (the gate's input) and, from an external engine,

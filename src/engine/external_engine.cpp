@@ -1,8 +1,11 @@
 #include "engine/external_engine.hpp"
 
 #include <fcntl.h>
+#include <poll.h>
+#include <pthread.h>
 #include <signal.h>
 #include <spawn.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -16,6 +19,7 @@
 #include <sstream>
 #include <thread>
 
+#include "core/mesh_topology.hpp"
 #include "nonplanar/io.hpp"
 
 extern char** environ;
@@ -173,92 +177,102 @@ std::optional<Error> flavor_kept(const PrintConfig& c, const std::string& gcode,
 
 }  // namespace
 
-Expected<std::string> run_engine(const EngineParams& e, const TriangleMesh& mesh,
-                                 const PrintConfig& c, const Context& ctx, const EngineRun& run) {
-  const bool orca = e.engine == Engine::orcaslicer;
-  const std::string name = orca ? "OrcaSlicer" : "PrusaSlicer";
-  const std::string exe = !e.path.empty() ? e.path : orca ? "orca-slicer" : "prusa-slicer";
+namespace {
+
+// One engine process: its folder (the input, its output and log), its process group's slot
+// for kill_running_engine(); stopped, if still running, and its folder removed on destruction.
+struct Launch {
   TempDir dir;
-  if (dir.path.empty()) return Error{Status::io_error, "engine: cannot make a temporary folder"};
-  const BoundingBox box = bounding_box(mesh);
-  const bool profile = !orca && !run.layer_tops.empty();
-  const fs::path stl = dir.path / (profile ? "core.3mf" : "normalized.stl"),
-                 out = dir.path / "out.gcode", log = dir.path / "engine.log",
-                 forced = dir.path / "forced.ini";
-  if (profile) {
-    const double top = box.max.z() - box.min.z();
-    std::vector<double> tops;
-    for (double z : run.layer_tops) tops.push_back(z - box.min.z());
-    const PackageFile f{"/Metadata/Slic3r_PE_layer_heights_profile.txt",
-                        layer_height_profile(tops, c.slice.layer_height, top)};
-    if (auto w = write_3mf(stl, mesh, {f}); !w) return w.error();
-  } else if (auto w = write_stl(stl, mesh); !w) {
-    return w.error();
+  fs::path input, out, log;
+  pid_t pid = 0;
+  std::atomic<pid_t>* slot = nullptr;
+  bool reaped = false;
+  bool waiting = false;  ///< started early, never given its mesh: killed at once
+  int status = 0;
+  Launch() = default;
+  Launch(const Launch&) = delete;
+  Launch& operator=(const Launch&) = delete;
+  ~Launch() {
+    if (pid > 0 && !reaped && waiting) {
+      ::kill(-pid, SIGKILL);  // blocked opening its input: nothing of its own to save
+      waitpid(pid, &status, 0);
+    } else if (pid > 0 && !reaped) {
+      stop_engine(pid, &status);
+    }
+    if (slot) slot->store(0);
   }
-  // Where the part is: the engine centres its box there.
-  const Vec2 centre = 0.5 * (box.min + box.max).head<2>();
+};
+
+// The engine's command line for `run` of a mesh whose XY box is centred at `centre`, read
+// from l.input (first_layer: the first layer's height, mm); PrusaSlicer's also writes
+// forced.ini into the folder.
+Expected<std::vector<std::string>> engine_args(const EngineParams& e, const PrintConfig& c,
+                                               const EngineRun& run, const Launch& l,
+                                               const Vec2& centre, double first_layer,
+                                               const std::string& exe) {
   std::vector<std::string> args{exe};
-  if (!orca) {
-    // The user's overrides and what we force go in a file loaded after the profile: there a
-    // boolean reads "1" (on the command line it takes no value), and a key an older
-    // PrusaSlicer does not know (arc_fitting, 2.6+) is ignored rather than fatal. What is on
-    // the command line below overrides both.
-    auto forced_for_slab = [&](const std::string& key) {
-      return run.slab_layer_height > 0 &&
-             std::any_of(std::begin(kSlab), std::end(kSlab),
-                         [&](const auto& kv) { return key == kv.first; });
-    };
-    {
-      std::ofstream ini(forced);
-      // A key once, with its last value: presets by name and --set may both give it, and
-      // PrusaSlicer refuses an ini with a duplicate key.
-      std::map<std::string, std::size_t> last;
-      for (std::size_t i = 0; i < e.overrides.size(); ++i) last[e.overrides[i].first] = i;
-      for (std::size_t i = 0; i < e.overrides.size(); ++i) {
-        const auto& [key, value] = e.overrides[i];
-        if (last[key] == i && key != "retract_lift" && key != "spiral_vase" &&
-            key != "arc_fitting" && key != "layer_height" && key != "first_layer_height" &&
-            !forced_for_slab(key))
-          ini << key << " = " << value << "\n";
-      }
-      ini << "arc_fitting = disabled\n";
-      if (run.slab_layer_height > 0)
-        for (const auto& [key, value] : kSlab) ini << key << " = " << value << "\n";
-      if (!ini) return Error{Status::io_error, "engine: cannot write " + forced.string()};
-    }
-    args.push_back("--export-gcode");
-    if (!e.config.empty()) args.insert(args.end(), {"--load", e.config});
-    const double h = run.slab_layer_height > 0 ? run.slab_layer_height : c.slice.layer_height;
-    const double h1 = run.slab_layer_height > 0 ? run.slab_layer_height
-                      : profile                 ? run.layer_tops.front() - box.min.z()
-                                                : c.slice.first_layer_height;
-    args.insert(args.end(),
-                {"--load", forced.string(), "--layer-height", num(h), "--first-layer-height",
-                 num(h1), "--retract-lift", "0", "--no-spiral-vase", "--center",
-                 num(centre.x()) + "," + num(centre.y())});
-    if (e.config.empty()) {
-      char bed[160];
-      std::snprintf(bed, sizeof bed, "%gx%g,%gx%g,%gx%g,%gx%g", c.bed_min.x(), c.bed_min.y(),
-                    c.bed_max.x(), c.bed_min.y(), c.bed_max.x(), c.bed_max.y(), c.bed_min.x(),
-                    c.bed_max.y());
-      args.insert(args.end(),
-                  {"--bed-shape", bed, "--nozzle-diameter", num(c.paths.nozzle_diameter),
-                   "--filament-diameter", num(c.gcode.filament_diameter)});
-    }
-    args.insert(args.end(), {"--output", out.string(), stl.string()});
-  } else {
+  if (e.engine == Engine::orcaslicer) {
     // OrcaSlicer's documented command line (untested here: it is not packaged for Debian).
-    args.insert(args.end(), {"--slice", "0", "--outputdir", dir.path.string()});
+    args.insert(args.end(), {"--slice", "0", "--outputdir", l.dir.path.string()});
     if (!e.config.empty()) args.insert(args.end(), {"--load-settings", e.config});
     if (!e.filaments.empty()) args.insert(args.end(), {"--load-filaments", e.filaments});
-    args.push_back(stl.string());
+    args.push_back(l.input.string());
+    return args;
   }
+  // The user's overrides and what we force go in a file loaded after the profile: there a
+  // boolean reads "1" (on the command line it takes no value), and a key an older PrusaSlicer
+  // does not know (arc_fitting, 2.6+) is ignored rather than fatal. What is on the command
+  // line below overrides both.
+  const fs::path forced = l.dir.path / "forced.ini";
+  auto forced_for_slab = [&](const std::string& key) {
+    return run.slab_layer_height > 0 &&
+           std::any_of(std::begin(kSlab), std::end(kSlab),
+                       [&](const auto& kv) { return key == kv.first; });
+  };
+  {
+    std::ofstream ini(forced);
+    // A key once, with its last value: presets by name and --set may both give it, and
+    // PrusaSlicer refuses an ini with a duplicate key.
+    std::map<std::string, std::size_t> last;
+    for (std::size_t i = 0; i < e.overrides.size(); ++i) last[e.overrides[i].first] = i;
+    for (std::size_t i = 0; i < e.overrides.size(); ++i) {
+      const auto& [key, value] = e.overrides[i];
+      if (last[key] == i && key != "retract_lift" && key != "spiral_vase" && key != "arc_fitting" &&
+          key != "layer_height" && key != "first_layer_height" && !forced_for_slab(key))
+        ini << key << " = " << value << "\n";
+    }
+    ini << "arc_fitting = disabled\n";
+    if (run.slab_layer_height > 0)
+      for (const auto& [key, value] : kSlab) ini << key << " = " << value << "\n";
+    if (!ini) return Error{Status::io_error, "engine: cannot write " + forced.string()};
+  }
+  args.push_back("--export-gcode");
+  if (!e.config.empty()) args.insert(args.end(), {"--load", e.config});
+  const double h = run.slab_layer_height > 0 ? run.slab_layer_height : c.slice.layer_height;
+  args.insert(args.end(),
+              {"--load", forced.string(), "--layer-height", num(h), "--first-layer-height",
+               num(first_layer), "--retract-lift", "0", "--no-spiral-vase", "--center",
+               num(centre.x()) + "," + num(centre.y())});
+  if (e.config.empty()) {
+    char bed[160];
+    std::snprintf(bed, sizeof bed, "%gx%g,%gx%g,%gx%g,%gx%g", c.bed_min.x(), c.bed_min.y(),
+                  c.bed_max.x(), c.bed_min.y(), c.bed_max.x(), c.bed_max.y(), c.bed_min.x(),
+                  c.bed_max.y());
+    args.insert(args.end(), {"--bed-shape", bed, "--nozzle-diameter", num(c.paths.nozzle_diameter),
+                             "--filament-diameter", num(c.gcode.filament_diameter)});
+  }
+  args.insert(args.end(), {"--output", l.out.string(), l.input.string()});
+  return args;
+}
+
+// Starts the engine (stdout and stderr to l.log) in a process group of its own.
+Expected<void> spawn(Launch& l, std::vector<std::string> args, const std::string& name) {
   std::vector<char*> argv;
   for (std::string& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
   posix_spawn_file_actions_t fa;
   posix_spawn_file_actions_init(&fa);
-  posix_spawn_file_actions_addopen(&fa, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_addopen(&fa, 1, l.log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
   posix_spawn_file_actions_adddup2(&fa, 1, 2);
   posix_spawn_file_actions_addopen(&fa, 0, "/dev/null", O_RDONLY, 0);
   posix_spawnattr_t attr;
@@ -266,42 +280,90 @@ Expected<std::string> run_engine(const EngineParams& e, const TriangleMesh& mesh
   posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETPGROUP);
   posix_spawnattr_setpgroup(&attr, 0);  // a group of its own, led by the engine
   pid_t pid = 0;
-  const int rc = posix_spawnp(&pid, exe.c_str(), &fa, &attr, argv.data(), environ);
+  const int rc = posix_spawnp(&pid, argv[0], &fa, &attr, argv.data(), environ);
   posix_spawn_file_actions_destroy(&fa);
   posix_spawnattr_destroy(&attr);
-  std::atomic<pid_t>* slot = nullptr;
-  for (int i = 0; rc == 0 && i < kEngineSlots && !slot; ++i)
-    if (pid_t none = 0; g_engine_group[i].compare_exchange_strong(none, pid))
-      slot = &g_engine_group[i];
-  struct Forget {
-    std::atomic<pid_t>* slot;
-    ~Forget() {
-      if (slot) slot->store(0);
-    }
-  } forget{slot};
   if (rc != 0)
-    return Error{Status::io_error, "engine: cannot run '" + exe + "' (" + name +
+    return Error{Status::io_error, "engine: cannot run '" + args[0] + "' (" + name +
                                        " not installed? --engine-path names it)"};
-  int status = 0;
-  for (;;) {
-    const pid_t w = waitpid(pid, &status, WNOHANG);
-    if (w == pid) break;
-    if (w < 0) return Error{Status::io_error, "engine: lost track of " + name};
+  l.pid = pid;
+  for (int i = 0; i < kEngineSlots && !l.slot; ++i)
+    if (pid_t none = 0; g_engine_group[i].compare_exchange_strong(none, pid))
+      l.slot = &g_engine_group[i];
+  return {};
+}
+
+// Has the engine exited (its status kept)?
+bool exited(Launch& l) {
+  if (!l.reaped && waitpid(l.pid, &l.status, WNOHANG) == l.pid) l.reaped = true;
+  return l.reaped;
+}
+
+// Writes `text` into the pipe the engine reads its mesh from, once the engine opens it (after
+// loading its libraries and profile: the time this saves). An engine that stopped before
+// reading it all is left to finish() to report. A SIGPIPE the writes raise is dropped.
+Expected<void> feed(Launch& l, const std::string& text, const Context& ctx) {
+  sigset_t pipe_signal, old;
+  sigemptyset(&pipe_signal);
+  sigaddset(&pipe_signal, SIGPIPE);
+  pthread_sigmask(SIG_BLOCK, &pipe_signal, &old);
+  struct Restore {
+    sigset_t &set, &old;
+    ~Restore() {
+      const timespec now{};
+      while (sigtimedwait(&set, nullptr, &now) > 0) {
+      }
+      pthread_sigmask(SIG_SETMASK, &old, nullptr);
+    }
+  } restore{pipe_signal, old};
+  int fd = -1;
+  while ((fd = ::open(l.input.c_str(), O_WRONLY | O_NONBLOCK | O_CLOEXEC)) < 0) {
+    if (errno != ENXIO && errno != EINTR)
+      return Error{Status::io_error, "engine: cannot write its input " + l.input.string()};
+    if (exited(l)) return {};
+    if (ctx.cancelled()) return Error{Status::cancelled, "cancelled"};
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  std::size_t done = 0;
+  while (done < text.size()) {
+    const ssize_t n =
+        ::write(fd, text.data() + done, std::min<std::size_t>(text.size() - done, 1 << 16));
+    if (n > 0) {
+      done += static_cast<std::size_t>(n);
+    } else if (n < 0 && errno == EAGAIN) {
+      pollfd p{fd, POLLOUT, 0};
+      ::poll(&p, 1, 20);
+      if (ctx.cancelled()) return ::close(fd), Error{Status::cancelled, "cancelled"};
+    } else if (!(n < 0 && errno == EINTR)) {
+      break;  // EPIPE: it stopped reading
+    }
+  }
+  ::close(fd);
+  return {};
+}
+
+// Waits for the engine (stopping it on cancellation) and reads its file.
+Expected<std::string> finish(Launch& l, const EngineParams& e, const PrintConfig& c,
+                             const Context& ctx) {
+  const bool orca = e.engine == Engine::orcaslicer;
+  const std::string name = orca ? "OrcaSlicer" : "PrusaSlicer";
+  while (!exited(l)) {
     if (ctx.cancelled()) {
-      stop_engine(pid, &status);
+      stop_engine(l.pid, &l.status);
+      l.reaped = true;
       return Error{Status::cancelled, "cancelled"};
     }
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    std::this_thread::sleep_for(std::chrono::milliseconds(orca ? 20 : 5));
   }
-  fs::path result = out;
+  fs::path result = l.out;
   if (orca) {  // it names its output itself (plate_1.gcode)
     result.clear();
     std::error_code ec;
-    for (const auto& f : fs::directory_iterator(dir.path, ec))
+    for (const auto& f : fs::directory_iterator(l.dir.path, ec))
       if (f.path().extension() == ".gcode") result = f.path();
   }
-  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0 || result.empty() || !fs::exists(result)) {
-    const std::string why = last_line(log);
+  if (!WIFEXITED(l.status) || WEXITSTATUS(l.status) != 0 || result.empty() || !fs::exists(result)) {
+    const std::string why = last_line(l.log);
     return Error{Status::io_error, "engine: " + name + " failed" + (why.empty() ? "" : ": " + why)};
   }
   std::ifstream in(result, std::ios::binary);
@@ -316,6 +378,85 @@ Expected<std::string> run_engine(const EngineParams& e, const TriangleMesh& mesh
   if (auto f = flavor_kept(c, gcode, name)) return *f;
   complete_config_block(gcode, c);  // the file says what its time estimate assumed
   return gcode;
+}
+
+}  // namespace
+
+struct EarlyEngine {
+  Launch launch;
+  Vec2 centre;
+  std::atomic<bool> taken{false};
+};
+
+void EarlyEngineDeleter::operator()(EarlyEngine* p) const {
+  delete p;
+}
+
+EarlyEnginePtr start_engine_early(const EngineParams& e, const PrintConfig& c,
+                                  const TriangleMesh& mesh) {
+  if (e.engine != Engine::prusaslicer) return nullptr;
+  // PrusaSlicer repairs an STL as it reads it (edges matched across small gaps, holes filled)
+  // and an OBJ not: the same G-code from both needs a mesh with nothing to repair (the
+  // CurviSlicer car, open in places, came out 7 facets apart).
+  const MeshTopology t = build_topology(mesh);
+  if (t.open_edges || t.non_manifold_edges || t.inconsistent_edges) return nullptr;
+  const BoundingBox box = bounding_box(mesh);
+  const Vec2 centre = 0.5 * (box.min + box.max).head<2>();
+  EarlyEnginePtr early(new EarlyEngine);
+  Launch& l = early->launch;
+  if (l.dir.path.empty()) return nullptr;
+  l.input = l.dir.path / "normalized.obj", l.out = l.dir.path / "out.gcode",
+  l.log = l.dir.path / "engine.log";
+  if (::mkfifo(l.input.c_str(), 0600) != 0) return nullptr;
+  auto args = engine_args(e, c, EngineRun{}, l, centre, c.slice.first_layer_height,
+                          !e.path.empty() ? e.path : "prusa-slicer");
+  if (!args || !spawn(l, std::move(*args), "PrusaSlicer")) return nullptr;
+  early->centre = centre;
+  l.waiting = true;
+  return early;
+}
+
+Expected<std::string> run_engine(const EngineParams& e, const TriangleMesh& mesh,
+                                 const PrintConfig& c, const Context& ctx, const EngineRun& run,
+                                 EarlyEngine* early) {
+  const bool orca = e.engine == Engine::orcaslicer;
+  const BoundingBox box = bounding_box(mesh);
+  // Where the part is: the engine centres its box there.
+  const Vec2 centre = 0.5 * (box.min + box.max).head<2>();
+  const bool plain = run.layer_tops.empty() && run.slab_layer_height <= 0;
+  if (early && plain && !orca && centre == early->centre && !early->taken.exchange(true)) {
+    std::size_t collapsed = 0;
+    std::string obj = obj_text(mesh, &collapsed);
+    if (collapsed == 0) {  // else an STL, which PrusaSlicer repairs as it did before
+      early->launch.waiting = false;
+      if (auto fed = feed(early->launch, obj, ctx); !fed) return fed.error();
+      return finish(early->launch, e, c, ctx);
+    }
+  }
+  const std::string exe = !e.path.empty() ? e.path : orca ? "orca-slicer" : "prusa-slicer";
+  Launch l;
+  if (l.dir.path.empty()) return Error{Status::io_error, "engine: cannot make a temporary folder"};
+  const bool profile = !orca && !run.layer_tops.empty();
+  l.input = l.dir.path / (profile ? "core.3mf" : "normalized.stl");
+  l.out = l.dir.path / "out.gcode", l.log = l.dir.path / "engine.log";
+  if (profile) {
+    const double top = box.max.z() - box.min.z();
+    std::vector<double> tops;
+    for (double z : run.layer_tops) tops.push_back(z - box.min.z());
+    const PackageFile f{"/Metadata/Slic3r_PE_layer_heights_profile.txt",
+                        layer_height_profile(tops, c.slice.layer_height, top)};
+    if (auto w = write_3mf(l.input, mesh, {f}); !w) return w.error();
+  } else if (auto w = write_stl(l.input, mesh); !w) {
+    return w.error();
+  }
+  const double h1 = run.slab_layer_height > 0 ? run.slab_layer_height
+                    : profile                 ? run.layer_tops.front() - box.min.z()
+                                              : c.slice.first_layer_height;
+  auto args = engine_args(e, c, run, l, centre, h1, exe);
+  if (!args) return args.error();
+  if (auto s = spawn(l, std::move(*args), orca ? "OrcaSlicer" : "PrusaSlicer"); !s)
+    return s.error();
+  return finish(l, e, c, ctx);
 }
 
 bool kill_running_engine() {

@@ -1,6 +1,9 @@
+#include <array>
+#include <charconv>
 #include <cstdint>
 #include <cstring>
 #include <ostream>
+#include <unordered_map>
 
 #include "core/atomic_file.hpp"
 #include "nonplanar/io.hpp"
@@ -31,6 +34,68 @@ Expected<void> write_stl(const std::filesystem::path& file, const TriangleMesh& 
     }
     return bool(out);
   });
+}
+
+namespace {
+
+struct FloatTripleHash {
+  std::size_t operator()(const std::array<std::uint32_t, 3>& k) const {
+    std::uint64_t h = 1469598103934665603ull;
+    for (std::uint32_t v : k) h = (h ^ v) * 1099511628211ull;
+    return static_cast<std::size_t>(h);
+  }
+};
+
+}  // namespace
+
+std::string obj_text(const TriangleMesh& mesh, std::size_t* collapsed) {
+  if (collapsed) *collapsed = 0;
+  // Keyed by the floats' bits: -0.0f and 0.0f stay two vertices, as an STL reader comparing
+  // bytes keeps them.
+  using Key = std::array<std::uint32_t, 3>;
+  std::unordered_map<Key, std::uint32_t, FloatTripleHash> index;
+  index.reserve(mesh.vertices.size());
+  std::string v, f;
+  v.reserve(mesh.vertices.size() * 36);
+  f.reserve(mesh.faces.size() * 24);
+  char buf[128];
+  auto key_of = [](const Vec3& p, float c[3]) {
+    Key key;
+    for (int k = 0; k < 3; ++k) {
+      c[k] = static_cast<float>(p[k]);
+      std::memcpy(&key[static_cast<std::size_t>(k)], &c[k], 4);
+    }
+    return key;
+  };
+  for (const auto& face : mesh.faces) {
+    float c[3][3];
+    Key keys[3];
+    for (int k = 0; k < 3; ++k) keys[k] = key_of(mesh.vertices[face[k]], c[k]);
+    if (keys[0] == keys[1] || keys[1] == keys[2] || keys[0] == keys[2]) {
+      if (collapsed) ++*collapsed;
+      continue;
+    }
+    std::uint32_t id[3];
+    for (int k = 0; k < 3; ++k) {
+      const auto [it, added] = index.emplace(keys[k], static_cast<std::uint32_t>(index.size() + 1));
+      id[k] = it->second;
+      if (!added) continue;
+      char* e = buf;
+      *e++ = 'v';
+      // The float's own value as a double, in the fewest digits that read back as that
+      // double: a reader parsing to float or to double, then to float, gets the float.
+      for (float x : c[k])
+        *e++ = ' ', e = std::to_chars(e, buf + sizeof buf, static_cast<double>(x)).ptr;
+      *e++ = '\n';
+      v.append(buf, e);
+    }
+    char* e = buf;
+    *e++ = 'f';
+    for (std::uint32_t i : id) *e++ = ' ', e = std::to_chars(e, buf + sizeof buf, i).ptr;
+    *e++ = '\n';
+    f.append(buf, e);
+  }
+  return v + f;
 }
 
 Expected<void> write_ply_face_colors(const std::filesystem::path& file, const TriangleMesh& mesh,

@@ -61,6 +61,9 @@ struct Prepared {
   /// plans exactly what the deferred one did (on the bunny through PrusaSlicer, 1.1 s of
   /// blend checks and field again).
   mutable std::optional<std::pair<std::vector<int>, LayerPlan>> last_plan;
+  /// PrusaSlicer as the engine, loading while the layers are planned (the first plain run
+  /// takes it: the stacks' normalised mesh, or the part when none is curved).
+  EarlyEnginePtr engine;
 };
 
 Expected<SliceResult> attempt(const TriangleMesh& mesh, const SliceJob& job, const Prepared& pre,
@@ -125,7 +128,7 @@ Expected<SliceResult> attempt(const TriangleMesh& mesh, const SliceJob& job, con
       }
     }
   }
-  const EngineRoute route{job.engine, job.print, job.layers, job.map_back};
+  const EngineRoute route{job.engine, job.print, job.layers, job.map_back, pre.engine.get()};
   auto sliced = slice_with(*to_slice, r.nonplanar ? r.plan.field.get() : nullptr, route, ctx);
   if (!sliced) return sliced.error();
   r.layers = std::move(sliced->layers);
@@ -482,6 +485,7 @@ Expected<SliceResult> slice_rounds(const TriangleMesh& mesh, const SliceJob& job
                                    const Context& ctx) {
   Prepared pre;
   if (!job.planar_only) {
+    pre.engine = start_engine_early(job.engine, job.print, mesh);
     auto a = analyze(mesh, job.analysis, ctx);
     if (!a) return a.error();
     pre.analysis = std::move(*a);

@@ -2,14 +2,19 @@
 // mesh with the user's profile and its G-code is mapped back. Skipped where prusa-slicer is
 // not installed (scripts/test.sh installs it).
 #include <gtest/gtest.h>
+#include <sys/wait.h>
 
 #include <algorithm>
+#include <atomic>
+#include <cerrno>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <sstream>
 
+#include "engine/external_engine.hpp"
 #include "nonplanar/check.hpp"
 #include "nonplanar/io.hpp"
 #include "nonplanar/pipeline.hpp"
@@ -220,6 +225,126 @@ TEST(EnginePrusaSlicer, TheFileKeepsTheJunctionDeviationItWasTimedWith) {
   const double as_written = seconds("");
   EXPECT_DOUBLE_EQ(as_written, seconds(" --set machine_max_junction_deviation=0.05"));
   EXPECT_GT(std::abs(as_written - seconds(" --set machine_max_junction_deviation=0")), 1.0);
+}
+
+// What two runs of PrusaSlicer on one mesh agree on (it is not byte for byte the same from run
+// to run: its threads): the layers' heights, the filament and the box of what it extrudes.
+struct Made {
+  std::vector<std::string> layers;
+  double filament = 0;
+  double x0 = 1e9, y0 = 1e9, x1 = -1e9, y1 = -1e9;
+};
+Made made(const std::string& g) {
+  Made m;
+  std::istringstream in(g);
+  double e = 0;
+  for (std::string line; std::getline(in, line);) {
+    if (line.rfind(";Z:", 0) == 0) m.layers.push_back(line);
+    if (line.rfind("; filament used [mm] = ", 0) == 0) m.filament = std::stod(line.substr(23));
+    if (line.rfind("G92 E0", 0) == 0) e = 0;
+    if (line.rfind("G1 ", 0) != 0) continue;
+    const auto x = line.find(" X"), y = line.find(" Y"), ee = line.find(" E");
+    if (ee == std::string::npos || x == std::string::npos || y == std::string::npos) continue;
+    const double en = std::stod(line.substr(ee + 2));
+    if (en > e) {
+      const double px = std::stod(line.substr(x + 2)), py = std::stod(line.substr(y + 2));
+      m.x0 = std::min(m.x0, px), m.x1 = std::max(m.x1, px);
+      m.y0 = std::min(m.y0, py), m.y1 = std::max(m.y1, py);
+    }
+    e = en;
+  }
+  return m;
+}
+void expect_same_print(const std::string& a, const std::string& b) {
+  const Made p = made(a), q = made(b);
+  EXPECT_GT(p.layers.size(), 10u);
+  EXPECT_EQ(p.layers, q.layers);
+  EXPECT_NEAR(p.filament, q.filament, 0.002 * q.filament);
+  EXPECT_NEAR(p.x0, q.x0, 0.01);
+  EXPECT_NEAR(p.x1, q.x1, 0.01);
+  EXPECT_NEAR(p.y0, q.y0, 0.01);
+  EXPECT_NEAR(p.y1, q.y1, 0.01);
+}
+
+// The saddle with its heights changed as normalising changes them (z only, the XY box kept).
+TriangleMesh squeezed_saddle(const PrintConfig& c) {
+  TriangleMesh m = test::placed(test::saddle(), c);
+  for (Vec3& v : m.vertices) v.z() *= 0.9 + 0.001 * v.x();
+  return m;
+}
+
+// start_engine_early (external_engine.hpp): PrusaSlicer started before the mesh exists reads it
+// from a pipe as OBJ, and writes what it writes of the STL.
+TEST(EnginePrusaSlicer, AnEngineStartedEarlyWritesWhatOneStartedLateWrites) {
+  if (!have_prusaslicer()) GTEST_SKIP() << "prusa-slicer not installed";
+  PrintConfig c;
+  EngineParams e;
+  e.engine = Engine::prusaslicer;
+  const TriangleMesh placed = test::placed(test::saddle(), c);
+  const TriangleMesh mesh = squeezed_saddle(c);
+  EarlyEnginePtr early = start_engine_early(e, c, placed);
+  ASSERT_NE(early, nullptr);
+  auto piped = run_engine(e, mesh, c, {}, {}, early.get());
+  ASSERT_TRUE(piped) << piped.error().message;
+  auto late = run_engine(e, mesh, c, {});
+  ASSERT_TRUE(late) << late.error().message;
+  expect_same_print(*piped, *late);
+  // Taken once: a second run starts its own.
+  auto again = run_engine(e, mesh, c, {}, {}, early.get());
+  ASSERT_TRUE(again) << again.error().message;
+  expect_same_print(*again, *late);
+}
+
+TEST(EnginePrusaSlicer, AnEarlyEngineFailsAsALateOneDoes) {
+  if (!have_prusaslicer()) GTEST_SKIP() << "prusa-slicer not installed";
+  PrintConfig c;
+  EngineParams e;
+  e.engine = Engine::prusaslicer;
+  e.config = "/nonexistent/profile.ini";  // PrusaSlicer stops before it reads the mesh
+  const TriangleMesh mesh = test::placed(test::saddle(), c);
+  EarlyEnginePtr early = start_engine_early(e, c, mesh);
+  ASSERT_NE(early, nullptr);
+  auto piped = run_engine(e, mesh, c, {}, {}, early.get());
+  auto late = run_engine(e, mesh, c, {});
+  ASSERT_FALSE(piped);
+  ASSERT_FALSE(late);
+  EXPECT_EQ(piped.error().message, late.error().message);
+  EXPECT_NE(late.error().message.find("PrusaSlicer failed"), std::string::npos);
+}
+
+TEST(EnginePrusaSlicer, AnEarlyEngineStopsWhenCancelledOrDropped) {
+  if (!have_prusaslicer()) GTEST_SKIP() << "prusa-slicer not installed";
+  PrintConfig c;
+  EngineParams e;
+  e.engine = Engine::prusaslicer;
+  const TriangleMesh mesh = test::placed(test::saddle(), c);
+  std::atomic<bool> stop{true};
+  Context cancelled;
+  cancelled.cancel_flag = &stop;
+  EarlyEnginePtr early = start_engine_early(e, c, mesh);
+  ASSERT_NE(early, nullptr);
+  auto r = run_engine(e, mesh, c, cancelled, {}, early.get());
+  ASSERT_FALSE(r);
+  EXPECT_EQ(r.error().status, Status::cancelled);
+  early.reset();
+  // One never used, dropped: no child of ours is left, running or unreaped.
+  EarlyEnginePtr unused = start_engine_early(e, c, mesh);
+  ASSERT_NE(unused, nullptr);
+  unused.reset();
+  int status = 0;
+  EXPECT_EQ(waitpid(-1, &status, WNOHANG), -1);
+  EXPECT_EQ(errno, ECHILD);
+}
+
+TEST(EnginePrusaSlicer, NoEarlyEngineForAMeshPrusaSlicerWouldRepair) {
+  PrintConfig c;
+  EngineParams e;
+  e.engine = Engine::prusaslicer;
+  TriangleMesh open = test::placed(test::saddle(), c);
+  open.faces.pop_back();  // an STL of it is repaired as it is read, an OBJ is not
+  EXPECT_EQ(start_engine_early(e, c, open), nullptr);
+  e.engine = Engine::orcaslicer;
+  EXPECT_EQ(start_engine_early(e, c, test::placed(test::saddle(), c)), nullptr);
 }
 
 TEST(EngineOption, BadEngineOrMissingExecutableIsAOneLineError) {

@@ -1,6 +1,9 @@
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "io/readers.hpp"
+#include "nonplanar/io.hpp"
 #include "support/files.hpp"
 #include "support/solids.hpp"
 
@@ -98,6 +101,48 @@ TEST(OffErrors, TruncatedLyingAndOutOfRange) {
   EXPECT_FALSE(io::parse_off("PLY\n"));
   EXPECT_FALSE(io::parse_off("OFF\n3 1 0\n0 0 0\n1 x 0\n0 1 0\n3 0 1 2\n"));
   EXPECT_FALSE(io::parse_off("OFF\n-3 1 0\n"));
+}
+
+// obj_text is what PrusaSlicer reads through a pipe instead of our STL (external_engine.cpp):
+// it must give the same floats, vertex for vertex, as the binary STL of the mesh.
+TEST(ObjText, ReadsBackAsTheBinaryStlOfTheMesh) {
+  TriangleMesh m = test::icosphere(Vec3(110.3, 97.1, 12.0), 11.7, 3);
+  for (Vec3& v : m.vertices) v.z() += 0.013 * std::sin(0.37 * v.x()) + 1e-7 / 3;  // off float
+  std::size_t collapsed = 7;
+  const std::string text = obj_text(m, &collapsed);
+  EXPECT_EQ(collapsed, 0u);
+  auto back = io::parse_obj(text);
+  ASSERT_TRUE(back) << back.error().message;
+  const auto dir = test::temp_dir("obj_text");
+  ASSERT_TRUE(write_stl(dir / "m.stl", m));
+  MeshFormat format{};
+  auto stl = io::parse_stl(test::read_bytes(dir / "m.stl"), &format);
+  ASSERT_TRUE(stl) << stl.error().message;
+  ASSERT_EQ(back->faces.size(), m.faces.size());
+  ASSERT_EQ(back->vertices.size(), m.vertices.size());  // shared as the mesh shares them
+  ASSERT_EQ(stl->faces.size(), m.faces.size());
+  for (std::size_t f = 0; f < m.faces.size(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      const Vec3& a = back->vertices[back->faces[f][k]];
+      const Vec3& b = stl->vertices[stl->faces[f][k]];
+      for (int d = 0; d < 3; ++d) {
+        ASSERT_EQ(a[d], b[d]) << "face " << f << " corner " << k;
+        ASSERT_EQ(a[d], static_cast<double>(static_cast<float>(m.vertices[m.faces[f][k]][d])));
+      }
+    }
+}
+
+TEST(ObjText, FacesThatCollapseInFloatAreLeftOutAndCounted) {
+  TriangleMesh m;
+  m.vertices = {{0, 0, 0}, {10, 0, 0}, {0, 10, 0}, {10 + 1e-7, 0, 0}};  // 1 and 3: one float
+  m.faces = {{0, 1, 2}, {0, 3, 1}, {0, 2, 3}};
+  std::size_t collapsed = 0;
+  const std::string text = obj_text(m, &collapsed);
+  EXPECT_EQ(collapsed, 1u);
+  auto back = io::parse_obj(text);
+  ASSERT_TRUE(back) << back.error().message;
+  EXPECT_EQ(back->faces.size(), 2u);
+  EXPECT_EQ(back->vertices.size(), 3u);  // 1 and 3 shared, as an STL reader shares them
 }
 
 }  // namespace
