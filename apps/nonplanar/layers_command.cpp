@@ -144,7 +144,8 @@ int run(const LayersOptions& o) {
     if (!sh.patches.empty())
       j["shell"] = {{"patches", sh.patches},         {"shells", sh.shells},
                     {"layers", sh.layers},           {"thickness", sh.thickness},
-                    {"core_layers", sh.core_layers}, {"beside_stacks", !stacked.empty()}};
+                    {"core_layers", sh.core_layers}, {"beside_stacks", !stacked.empty()},
+                    {"narrowed", sh.narrowed}};
     else if (!sh.refused.empty())
       j["shell"] = {{"refused", sh.refused}};
     std::printf("%s\n", j.dump(2).c_str());
@@ -169,7 +170,8 @@ int run(const LayersOptions& o) {
                 sh.shells > 1 ? (std::to_string(sh.shells) + " shells").c_str() : "shell", beside,
                 sh.patches.size() == 1 ? "" : "es", list.c_str(), sh.layers, sh.thickness,
                 sh.core_layers);
-  else if (!sh.refused.empty())
+  if (!sh.narrowed.empty()) std::printf("    not wider: %s\n", sh.narrowed.c_str());
+  if (sh.patches.empty() && !sh.refused.empty())
     std::printf("  no shell%s: %s\n", beside, sh.refused.c_str());
   return kExitOk;
 }

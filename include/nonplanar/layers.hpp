@@ -169,6 +169,9 @@ struct ShellSummary {
   double thickness = 0;      ///< of each, mm (the thickest)
   std::size_t core_layers = 0;
   std::string refused;  ///< why not (empty when there is a shell)
+  /// Why the first shell follows fewer than all the curved patches: the refusal of the wider
+  /// shell tried first, "a shell over patches 0, 1: …" (empty: none tried).
+  std::string narrowed;
 };
 ShellSummary summarize_shell(const TriangleMesh& mesh, const Analysis& a, const LayerParams& p,
                              const std::vector<int>& stacked = {});

@@ -106,7 +106,9 @@ std::string rest_on_core(const TriangleMesh& mesh, const std::vector<char>& in_p
   s.N = N0;
   ShellRegion region =
       shell_region(mesh, in_patch, first.faces, s.N * s.t + 0.5, s.top, s.below, p, s.framed);
-  if (!region.refused.empty()) return first.why;
+  // Both reasons: the ornament's logo plate lies under its shell, and left to the core it
+  // stands above the dome round 61 % of it (the second is what a user would change).
+  if (!region.refused.empty()) return first.why + "; left to the core, " + region.refused;
   region.why_out.push_back(first.why);
   take_region(s, std::move(region));
   if (!under_shell(mesh, in_patch, s, p.max_angle_deg, 0.5).why.empty()) return first.why;
@@ -295,10 +297,21 @@ ShellPlan choose_first(const TriangleMesh& mesh, const Analysis& a, const LayerP
     if (k == 0) plan = plan_shell(mesh, a, all, p, 0, c.even_core);
     if (k == 1) some = plan_shell(mesh, a, near, p, 0, c.even_core);
   });
-  if (!plan.refused.empty() && group && some.refused.empty()) return some;
+  // The ankle base's rim prints as a shell, its ledge planar: say why not both.
+  auto narrowed = [&](ShellPlan s, const std::vector<int>& wider, const std::string& why) {
+    std::string names = wider.size() > 1 ? "a shell over patches" : "a shell over patch";
+    for (std::size_t k = 0; k < std::min<std::size_t>(wider.size(), 5); ++k)
+      names += (k ? ", " : " ") + std::to_string(wider[k]);
+    if (wider.size() > 5) names += " and " + std::to_string(wider.size() - 5) + " more";
+    s.narrowed = names + ": " + why;
+    return s;
+  };
+  if (!plan.refused.empty() && group && some.refused.empty())
+    return narrowed(std::move(some), all, plan.refused);
   if (!plan.refused.empty() && all.size() > 1) {
     ShellPlan one = plan_shell(mesh, a, {all.front()}, p, 0, c.even_core);
-    if (one.refused.empty()) plan = std::move(one);
+    if (one.refused.empty())
+      return narrowed(std::move(one), group ? near : all, group ? some.refused : plan.refused);
   }
   return plan;
 }
@@ -418,6 +431,7 @@ ShellSummary summarize_shell(const TriangleMesh& mesh, const Analysis& a, const 
   }
   if (plans.empty() || !s.refused.empty()) return s;
   const layers::ShellPlan& plan = plans.front();
+  s.narrowed = plan.narrowed;
   for (const layers::ShellPlan& q : plans) {
     s.patches.insert(s.patches.end(), q.patches.begin(), q.patches.end());
     s.layers = std::max(s.layers, q.N);

@@ -46,6 +46,9 @@ struct ShellPlan {
   /// What of the patches the shell leaves to the core because an overhang or another surface
   /// lies under it there, and why (empty: none).
   std::string left_out;
+  /// Why the shell follows fewer patches than all those it was chosen among: the wider
+  /// shell's refusal, "patches 0, 1: …" (empty: it follows them all).
+  std::string narrowed;
 
   bool in_region(double x, double y) const { return region.empty() || region.height(x, y) >= 0; }
   /// τ (shell_region.hpp): the core's layers up to this height are printed before the shell's

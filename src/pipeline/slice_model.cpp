@@ -222,6 +222,7 @@ void describe_shells(const std::vector<layers::ShellPlan>& shells, const std::st
   for (const layers::ShellPlan& s : shells)
     if (!s.left_out.empty())
       left_out += "; " + (shells.size() > 1 ? patch_names(s.patches) + ": " : "") + s.left_out;
+  if (!shells.front().narrowed.empty()) left_out += "; not " + shells.front().narrowed;
   r.notices.push_back(
       {Notice::Kind::shell, -1,
        patch_names(patches) +

@@ -168,6 +168,9 @@ TEST(ShellPlan, RefusesAShellMostlyPrintedInBands) {
   const layers::ShellPlan rim = layers::choose_shell(m->mesh, a, LayerParams{});
   EXPECT_TRUE(rim.refused.empty()) << rim.refused;
   EXPECT_EQ(rim.patches, std::vector<int>{0});
+  // It says why it is not the wider one (slice's notice and `layers` print it).
+  EXPECT_EQ(rim.narrowed, "a shell over patches 0, 1: " + why);
+  EXPECT_TRUE(layers::plan_shell(m->mesh, a, {0}, LayerParams{}).narrowed.empty());
 }
 
 }  // namespace
