@@ -430,7 +430,10 @@ Expected<std::string> run_engine(const EngineParams& e, const TriangleMesh& mesh
     if (collapsed == 0) {  // else an STL, which PrusaSlicer repairs as it did before
       early->launch.waiting = false;
       if (auto fed = feed(early->launch, obj, ctx); !fed) return fed.error();
-      return finish(early->launch, e, c, ctx);
+      auto gcode = finish(early->launch, e, c, ctx);
+      // A PrusaSlicer that failed (one whose reader seeks in an OBJ too, or a bad profile) is
+      // run again as before, on an STL: the user gets its file, or what that run says.
+      if (gcode || gcode.error().status != Status::io_error) return gcode;
     }
   }
   const std::string exe = !e.path.empty() ? e.path : orca ? "orca-slicer" : "prusa-slicer";

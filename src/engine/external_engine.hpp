@@ -65,7 +65,8 @@ EarlyEnginePtr start_engine_early(const EngineParams& e, const PrintConfig& c,
 /// SIGKILL after 3 s). Errors: io_error (engine missing, failed: its last output line; a
 /// file without the statistics or config block a slicer writes after the last layer, i.e.
 /// truncated), cancelled. `early`: an engine start_engine_early started with the same e and c;
-/// a plain run of a mesh centred where it expects takes it (once), else it is left alone.
+/// a plain run of a mesh centred where it expects takes it (once), else it is left alone; when
+/// it fails, the run starts its own on an STL, as without it.
 Expected<std::string> run_engine(const EngineParams& e, const TriangleMesh& mesh,
                                  const PrintConfig& c, const Context& ctx,
                                  const EngineRun& run = {}, EarlyEngine* early = nullptr);

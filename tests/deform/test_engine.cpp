@@ -312,6 +312,34 @@ TEST(EnginePrusaSlicer, AnEarlyEngineFailsAsALateOneDoes) {
   EXPECT_NE(late.error().message.find("PrusaSlicer failed"), std::string::npos);
 }
 
+// Another PrusaSlicer's reader might not take a pipe: the run then starts one of its own on an
+// STL, as before, and the user gets the file.
+TEST(EnginePrusaSlicer, AnEngineThatCannotReadThePipeIsRunAgainOnAnStl) {
+  if (!have_prusaslicer()) GTEST_SKIP() << "prusa-slicer not installed";
+  const auto dir = test::temp_dir("engine_no_pipe");
+  const auto fake = dir / "engine.sh";
+  {
+    std::ofstream(fake) << "#!/bin/sh\nfor a; do last=$a; done\n"
+                           "if [ -p \"$last\" ]; then echo 'cannot read a pipe'; exit 3; fi\n"
+                           "exec prusa-slicer \"$@\"\n";
+  }
+  std::filesystem::permissions(fake, std::filesystem::perms::owner_all);
+  PrintConfig c;
+  EngineParams e;
+  e.engine = Engine::prusaslicer;
+  e.path = fake.string();
+  const TriangleMesh mesh = test::placed(test::saddle(), c);
+  EarlyEnginePtr early = start_engine_early(e, c, mesh);
+  ASSERT_NE(early, nullptr);
+  auto r = run_engine(e, mesh, c, {}, {}, early.get());
+  ASSERT_TRUE(r) << r.error().message;
+  EngineParams plain = e;
+  plain.path.clear();
+  auto late = run_engine(plain, mesh, c, {});
+  ASSERT_TRUE(late) << late.error().message;
+  expect_same_print(*r, *late);
+}
+
 TEST(EnginePrusaSlicer, AnEarlyEngineStopsWhenCancelledOrDropped) {
   if (!have_prusaslicer()) GTEST_SKIP() << "prusa-slicer not installed";
   PrintConfig c;
