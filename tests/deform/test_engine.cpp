@@ -273,13 +273,20 @@ TriangleMesh squeezed_saddle(const PrintConfig& c) {
   return m;
 }
 
+// PrusaSlicer as the engine: `path` (empty: prusa-slicer on PATH), with `config` loaded.
+EngineParams prusaslicer(const std::string& path = {}, const std::string& config = {}) {
+  EngineParams e;
+  e.engine = Engine::prusaslicer;
+  e.path = path, e.config = config;
+  return e;
+}
+
 // start_engine_early (external_engine.hpp): PrusaSlicer started before the mesh exists reads it
 // from a pipe as OBJ, and writes what it writes of the STL.
 TEST(EnginePrusaSlicer, AnEngineStartedEarlyWritesWhatOneStartedLateWrites) {
   if (!have_prusaslicer()) GTEST_SKIP() << "prusa-slicer not installed";
   PrintConfig c;
-  EngineParams e;
-  e.engine = Engine::prusaslicer;
+  const EngineParams e = prusaslicer();
   const TriangleMesh placed = test::placed(test::saddle(), c);
   const TriangleMesh mesh = squeezed_saddle(c);
   EarlyEnginePtr early = start_engine_early(e, c, placed);
@@ -298,9 +305,8 @@ TEST(EnginePrusaSlicer, AnEngineStartedEarlyWritesWhatOneStartedLateWrites) {
 TEST(EnginePrusaSlicer, AnEarlyEngineFailsAsALateOneDoes) {
   if (!have_prusaslicer()) GTEST_SKIP() << "prusa-slicer not installed";
   PrintConfig c;
-  EngineParams e;
-  e.engine = Engine::prusaslicer;
-  e.config = "/nonexistent/profile.ini";  // PrusaSlicer stops before it reads the mesh
+  // PrusaSlicer stops before it reads the mesh.
+  const EngineParams e = prusaslicer({}, "/nonexistent/profile.ini");
   const TriangleMesh mesh = test::placed(test::saddle(), c);
   EarlyEnginePtr early = start_engine_early(e, c, mesh);
   ASSERT_NE(early, nullptr);
@@ -325,17 +331,13 @@ TEST(EnginePrusaSlicer, AnEngineThatCannotReadThePipeIsRunAgainOnAnStl) {
   }
   std::filesystem::permissions(fake, std::filesystem::perms::owner_all);
   PrintConfig c;
-  EngineParams e;
-  e.engine = Engine::prusaslicer;
-  e.path = fake.string();
+  const EngineParams e = prusaslicer(fake.string());
   const TriangleMesh mesh = test::placed(test::saddle(), c);
   EarlyEnginePtr early = start_engine_early(e, c, mesh);
   ASSERT_NE(early, nullptr);
   auto r = run_engine(e, mesh, c, {}, {}, early.get());
   ASSERT_TRUE(r) << r.error().message;
-  EngineParams plain = e;
-  plain.path.clear();
-  auto late = run_engine(plain, mesh, c, {});
+  auto late = run_engine(prusaslicer(), mesh, c, {});
   ASSERT_TRUE(late) << late.error().message;
   expect_same_print(*r, *late);
 }
@@ -343,8 +345,7 @@ TEST(EnginePrusaSlicer, AnEngineThatCannotReadThePipeIsRunAgainOnAnStl) {
 TEST(EnginePrusaSlicer, AnEarlyEngineStopsWhenCancelledOrDropped) {
   if (!have_prusaslicer()) GTEST_SKIP() << "prusa-slicer not installed";
   PrintConfig c;
-  EngineParams e;
-  e.engine = Engine::prusaslicer;
+  const EngineParams e = prusaslicer();
   const TriangleMesh mesh = test::placed(test::saddle(), c);
   std::atomic<bool> stop{true};
   Context cancelled;
@@ -366,8 +367,7 @@ TEST(EnginePrusaSlicer, AnEarlyEngineStopsWhenCancelledOrDropped) {
 
 TEST(EnginePrusaSlicer, NoEarlyEngineForAMeshPrusaSlicerWouldRepair) {
   PrintConfig c;
-  EngineParams e;
-  e.engine = Engine::prusaslicer;
+  EngineParams e = prusaslicer();
   TriangleMesh open = test::placed(test::saddle(), c);
   open.faces.pop_back();  // an STL of it is repaired as it is read, an OBJ is not
   EXPECT_EQ(start_engine_early(e, c, open), nullptr);
