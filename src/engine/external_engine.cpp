@@ -189,7 +189,9 @@ struct Launch {
   bool reaped = false;
   bool waiting = false;  ///< started early, never given its mesh: killed at once
   int status = 0;
-  Launch() = default;
+  /// The folder made, the engine to read `input_name` in it.
+  explicit Launch(const char* input_name)
+      : input(dir.path / input_name), out(dir.path / "out.gcode"), log(dir.path / "engine.log") {}
   Launch(const Launch&) = delete;
   Launch& operator=(const Launch&) = delete;
   ~Launch() {
@@ -263,6 +265,11 @@ Expected<std::vector<std::string>> engine_args(const EngineParams& e, const Prin
   }
   args.insert(args.end(), {"--output", l.out.string(), l.input.string()});
   return args;
+}
+
+// The engine's executable: --engine-path, else the one on PATH.
+std::string engine_exe(const EngineParams& e) {
+  return !e.path.empty() ? e.path : e.engine == Engine::orcaslicer ? "orca-slicer" : "prusa-slicer";
 }
 
 // Starts the engine (stdout and stderr to l.log) in a process group of its own.
@@ -383,7 +390,7 @@ Expected<std::string> finish(Launch& l, const EngineParams& e, const PrintConfig
 }  // namespace
 
 struct EarlyEngine {
-  Launch launch;
+  Launch launch{"normalized.obj"};
   Vec2 centre;
   std::atomic<bool> taken{false};
 };
@@ -404,12 +411,8 @@ EarlyEnginePtr start_engine_early(const EngineParams& e, const PrintConfig& c,
   const Vec2 centre = 0.5 * (box.min + box.max).head<2>();
   EarlyEnginePtr early(new EarlyEngine);
   Launch& l = early->launch;
-  if (l.dir.path.empty()) return nullptr;
-  l.input = l.dir.path / "normalized.obj", l.out = l.dir.path / "out.gcode",
-  l.log = l.dir.path / "engine.log";
-  if (::mkfifo(l.input.c_str(), 0600) != 0) return nullptr;
-  auto args = engine_args(e, c, EngineRun{}, l, centre, c.slice.first_layer_height,
-                          !e.path.empty() ? e.path : "prusa-slicer");
+  if (l.dir.path.empty() || ::mkfifo(l.input.c_str(), 0600) != 0) return nullptr;
+  auto args = engine_args(e, c, EngineRun{}, l, centre, c.slice.first_layer_height, engine_exe(e));
   if (!args || !spawn(l, std::move(*args), "PrusaSlicer")) return nullptr;
   early->centre = centre;
   l.waiting = true;
@@ -429,19 +432,17 @@ Expected<std::string> run_engine(const EngineParams& e, const TriangleMesh& mesh
     std::string obj = obj_text(mesh, &collapsed);
     if (collapsed == 0) {  // else an STL, which PrusaSlicer repairs as it did before
       early->launch.waiting = false;
-      if (auto fed = feed(early->launch, obj, ctx); !fed) return fed.error();
-      auto gcode = finish(early->launch, e, c, ctx);
-      // A PrusaSlicer that failed (one whose reader seeks in an OBJ too, or a bad profile) is
-      // run again as before, on an STL: the user gets its file, or what that run says.
+      auto fed = feed(early->launch, obj, ctx);
+      auto gcode = fed ? finish(early->launch, e, c, ctx) : Expected<std::string>(fed.error());
+      // A pipe that could not be written, or a PrusaSlicer that failed (one whose reader seeks
+      // in an OBJ too, or a bad profile): run again as before, on an STL; the user gets its
+      // file, or what that run says.
       if (gcode || gcode.error().status != Status::io_error) return gcode;
     }
   }
-  const std::string exe = !e.path.empty() ? e.path : orca ? "orca-slicer" : "prusa-slicer";
-  Launch l;
-  if (l.dir.path.empty()) return Error{Status::io_error, "engine: cannot make a temporary folder"};
   const bool profile = !orca && !run.layer_tops.empty();
-  l.input = l.dir.path / (profile ? "core.3mf" : "normalized.stl");
-  l.out = l.dir.path / "out.gcode", l.log = l.dir.path / "engine.log";
+  Launch l(profile ? "core.3mf" : "normalized.stl");
+  if (l.dir.path.empty()) return Error{Status::io_error, "engine: cannot make a temporary folder"};
   if (profile) {
     const double top = box.max.z() - box.min.z();
     std::vector<double> tops;
@@ -455,7 +456,7 @@ Expected<std::string> run_engine(const EngineParams& e, const TriangleMesh& mesh
   const double h1 = run.slab_layer_height > 0 ? run.slab_layer_height
                     : profile                 ? run.layer_tops.front() - box.min.z()
                                               : c.slice.first_layer_height;
-  auto args = engine_args(e, c, run, l, centre, h1, exe);
+  auto args = engine_args(e, c, run, l, centre, h1, engine_exe(e));
   if (!args) return args.error();
   if (auto s = spawn(l, std::move(*args), orca ? "OrcaSlicer" : "PrusaSlicer"); !s)
     return s.error();

@@ -47,7 +47,7 @@ struct ShellPlan {
   /// lies under it there, and why (empty: none).
   std::string left_out;
   /// Why the shell follows fewer patches than all those it was chosen among: the wider
-  /// shell's refusal, "patches 0, 1: …" (empty: it follows them all).
+  /// shell's refusal, "a shell over patches 0, 1: …" (empty: it follows them all).
   std::string narrowed;
 
   bool in_region(double x, double y) const { return region.empty() || region.height(x, y) >= 0; }
