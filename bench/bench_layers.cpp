@@ -1,9 +1,12 @@
 // Stack construction plus optimisation for one 50 × 50 mm patch (issue 4 target: <= 0.5 s),
-// the normalisation of its mesh, and a whole slice that prints as a shell.
+// one evaluation of its optimiser's cost and gradient, the normalisation of its mesh, and a
+// whole slice that prints as a shell.
 #include <benchmark/benchmark.h>
 
 #include <cmath>
 
+#include "layers/patch_raster.hpp"
+#include "layers/printability_cost.hpp"
 #include "nonplanar/deform.hpp"
 #include "nonplanar/layers.hpp"
 #include "nonplanar/pipeline.hpp"
@@ -42,6 +45,30 @@ void BM_PlanLayers50mm(benchmark::State& state) {
   }
 }
 
+// The stack optimiser's cost and gradient, as each of its iterations evaluates them: the
+// patch's ~40 × 40 quadrature grid, 28 layers (the Prusa sphere's stack: 100 iterations),
+// every term active (layers jittered out of the limits, a tight heater clearance).
+void BM_PrintabilityCost(benchmark::State& state) {
+  namespace layers = nonplanar::layers;
+  const Input& in = input();
+  const nonplanar::HeightField& top = in.fits[0].surface;
+  const layers::PatchRaster r = layers::rasterize_patch(in.mesh, in.analysis.patches[0], 0.25, 0);
+  layers::StackGrid g;
+  layers::build_stack_grid(g, top, 50.0 / 40, r.mask, r.origin, r.cell, r.nx, r.ny);
+  g.pair_within(6.0, 2.0);
+  const int N = 27, nc = top.surface.n_u * top.surface.n_v;
+  Eigen::MatrixXd Z(N + 1, nc);
+  for (int i = 0; i <= N; ++i)
+    for (int j = 0; j < nc; ++j)
+      Z(i, j) = (1.0 - i / double(N)) * top.surface.points[j].z() + i / double(N) * 4.0 +
+                (i > 0 && i < N ? 0.05 * std::sin(i * 7.0 + j) : 0.0);
+  const layers::CostTerms terms{0.2, 0.105, 0.295, 0.05, 1e5, std::tan(0.5) - 0.01, 0.5};
+  Eigen::MatrixXd grad;
+  for (auto _ : state) benchmark::DoNotOptimize(layers::printability_cost(g, Z, terms, &grad));
+  state.counters["samples"] = static_cast<double>(g.xy.size());
+  state.counters["controls"] = nc;
+}
+
 void BM_NormalizeMesh50mm(benchmark::State& state) {
   const Input& in = input();
   auto plan = nonplanar::plan_layers(in.mesh, in.analysis, in.fits, in.ids, {}, {});
@@ -65,6 +92,7 @@ void BM_SliceRibShell(benchmark::State& state) {
 }
 
 BENCHMARK(BM_PlanLayers50mm)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_PrintabilityCost)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_NormalizeMesh50mm)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_SliceRibShell)->Unit(benchmark::kMillisecond)->UseRealTime();
 

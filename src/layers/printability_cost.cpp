@@ -30,11 +30,6 @@ void StackGrid::pair_within(double radius, double spacing) {
     }
 }
 
-int StackGrid::control(int k, int a) const {
-  const int i0 = first[k] / n_v, j0 = first[k] % n_v;
-  return (i0 + a / (q + 1)) * n_v + (j0 + a % (q + 1));
-}
-
 void build_stack_grid(StackGrid& g, const HeightField& hf, double step,
                       const std::vector<char>& raster_mask, const Vec2& raster_origin,
                       double raster_cell, int raster_nx, int raster_ny) {
@@ -63,6 +58,8 @@ void build_stack_grid(StackGrid& g, const HeightField& hf, double step,
       nurbs::ders_basis_funs(su, uv.x(), s.p, 1, s.U, du.data());
       nurbs::ders_basis_funs(sv, uv.y(), s.q, 1, s.V, dv.data());
       g.first.push_back((su - s.p) * s.n_v + (sv - s.q));
+      for (int a = 0; a <= s.p; ++a)
+        for (int c = 0; c <= s.q; ++c) g.ctrl.push_back((su - s.p + a) * s.n_v + (sv - s.q + c));
       // Rational basis R = N w / W and its derivatives (quotient rule), in x and y.
       double W = 0, Wu = 0, Wv = 0;
       for (int a = 0; a <= s.p; ++a)
@@ -108,14 +105,18 @@ double printability_cost(const StackGrid& g, const Eigen::MatrixXd& Z, const Cos
       const double* R = &g.R[static_cast<std::size_t>(k) * g.m];
       const double* Rx = &g.Rx[static_cast<std::size_t>(k) * g.m];
       const double* Ry = &g.Ry[static_cast<std::size_t>(k) * g.m];
+      const int* C = &g.ctrl[static_cast<std::size_t>(k) * g.m];
+      // Basis function by basis function, down a control's column of Z (its layers lie next
+      // to each other): each S_i is still summed in the order of a.
+      std::fill(S.begin(), S.end(), 0.0), std::fill(Sx.begin(), Sx.end(), 0.0);
+      std::fill(Sy.begin(), Sy.end(), 0.0);
+      for (int a = 0; a < g.m; ++a) {
+        const double* z = &Z(0, C[a]);
+        const double r = R[a], rx = Rx[a], ry = Ry[a];
+        for (int i = 0; i < L; ++i) S[i] += r * z[i], Sx[i] += rx * z[i], Sy[i] += ry * z[i];
+      }
       for (int i = 0; i < L; ++i) {
-        double s = 0, sx = 0, sy = 0;
-        for (int a = 0; a < g.m; ++a) {
-          const double z = Z(i, g.control(k, a));
-          s += R[a] * z, sx += Rx[a] * z, sy += Ry[a] * z;
-        }
-        S[i] = s, Sx[i] = sx, Sy[i] = sy;
-        if (pairs) all[static_cast<std::size_t>(i) * n + k] = s;
+        if (pairs) all[static_cast<std::size_t>(i) * n + k] = S[i];
         dS[i] = dSx[i] = dSy[i] = 0;
       }
       const double ak = g.area[k];
@@ -143,7 +144,11 @@ double printability_cost(const StackGrid& g, const Eigen::MatrixXd& Z, const Cos
       // bent the layers over the patch after them and its result was thrown away (13 of 25
       // stacks on 12 real parts). Limits are the stack's over the patch, as the stack's
       // figures measure them; the blend check judges the layers round it.
+      // Most layers are well under the limit: the square screens them (with room for its
+      // rounding) before the exact hypot, which was a tenth of an evaluation.
+      const double g2 = c.g * c.g * (1 - 1e-9);
       for (int i = 1; on && i + 1 < L; ++i) {
+        if (Sx[i] * Sx[i] + Sy[i] * Sy[i] <= g2) continue;
         const double sl = std::hypot(Sx[i], Sy[i]);
         if (sl > c.g) {
           cost += ak * c.mu * (sl - c.g) * (sl - c.g);
@@ -152,10 +157,14 @@ double printability_cost(const StackGrid& g, const Eigen::MatrixXd& Z, const Cos
         }
       }
       if (!gr) continue;
-      for (int i = 1; i + 1 < L; ++i) {
-        if (dS[i] == 0 && dSx[i] == 0 && dSy[i] == 0) continue;
-        for (int a = 0; a < g.m; ++a)
-          (*gr)(i - 1, g.control(k, a)) += dS[i] * R[a] + dSx[i] * Rx[a] + dSy[i] * Ry[a];
+      // Each (layer, control) gets one term per sample, in sample order, as before the loops
+      // were swapped; layers with no term are left alone.
+      for (int a = 0; a < g.m; ++a) {
+        double* gc = gr->data() + static_cast<std::size_t>(C[a]) * gr->rows();  // column
+        const double r = R[a], rx = Rx[a], ry = Ry[a];
+        for (int i = 1; i + 1 < L; ++i)
+          if (dS[i] != 0 || dSx[i] != 0 || dSy[i] != 0)
+            gc[i - 1] += dS[i] * r + dSx[i] * rx + dSy[i] * ry;
       }
     }
     part[ch] = cost;

@@ -27,6 +27,7 @@ struct StackGrid {
   std::vector<char> on_patch;
   int m = 0;                      ///< basis functions per sample, (p+1)(q+1)
   std::vector<int> first;         ///< per sample: (i0, j0) of its span as i0·n_v + j0
+  std::vector<int> ctrl;          ///< m per sample: control index of each basis function
   std::vector<double> R, Rx, Ry;  ///< m per sample: basis, ∂/∂x, ∂/∂y
   int n_u = 0, n_v = 0, q = 0;
   int nx = 0, ny = 0;  ///< sample k = i·ny + j at (i + ½, j + ½)·step
@@ -36,7 +37,9 @@ struct StackGrid {
   /// Fills block_pairs on a subgrid of about `spacing` mm over the patch's samples.
   void pair_within(double radius, double spacing);
 
-  int control(int k, int a) const;  ///< control index of the a-th basis function of sample k
+  /// Control index of the a-th basis function of sample k (a table: the cost reads it
+  /// m·L times per sample and evaluation, and working it out took two divisions each).
+  int control(int k, int a) const { return ctrl[static_cast<std::size_t>(k) * m + a]; }
 };
 
 struct CostTerms {
