@@ -102,6 +102,9 @@ double printability_cost(const StackGrid& g, const Eigen::MatrixXd& Z, const Cos
     const int k0 = static_cast<int>(static_cast<long>(n) * ch / kChunks);
     const int k1 = static_cast<int>(static_cast<long>(n) * (ch + 1) / kChunks);
     for (int k = k0; k < k1; ++k) {
+      // Every term is the patch's (see the limits below), and so is every heater-block pair:
+      // a sample off the patch adds nothing (a fifth of the sphere's).
+      if (!g.on_patch[k]) continue;
       const double* R = &g.R[static_cast<std::size_t>(k) * g.m];
       const double* Rx = &g.Rx[static_cast<std::size_t>(k) * g.m];
       const double* Ry = &g.Ry[static_cast<std::size_t>(k) * g.m];
@@ -120,21 +123,18 @@ double printability_cost(const StackGrid& g, const Eigen::MatrixXd& Z, const Cos
         dS[i] = dSx[i] = dSy[i] = 0;
       }
       const double ak = g.area[k];
-      const bool on = g.on_patch[k];
       for (int i = 0; i + 1 < L; ++i) {
         const double t = S[i] - S[i + 1];
         double dt = 0;  // ∂C/∂t
-        if (on) {
-          cost += ak * (t - c.h) * (t - c.h);
-          dt += 2 * ak * (t - c.h);
-          const double ex = Sx[i] - Sx[i + 1], ey = Sy[i] - Sy[i + 1];
-          cost += ak * c.lambda * (ex * ex + ey * ey);
-          dSx[i] += 2 * ak * c.lambda * ex, dSx[i + 1] -= 2 * ak * c.lambda * ex;
-          dSy[i] += 2 * ak * c.lambda * ey, dSy[i + 1] -= 2 * ak * c.lambda * ey;
-        }
-        if (on && t < c.h_min)
+        cost += ak * (t - c.h) * (t - c.h);
+        dt += 2 * ak * (t - c.h);
+        const double ex = Sx[i] - Sx[i + 1], ey = Sy[i] - Sy[i + 1];
+        cost += ak * c.lambda * (ex * ex + ey * ey);
+        dSx[i] += 2 * ak * c.lambda * ex, dSx[i + 1] -= 2 * ak * c.lambda * ex;
+        dSy[i] += 2 * ak * c.lambda * ey, dSy[i + 1] -= 2 * ak * c.lambda * ey;
+        if (t < c.h_min)
           cost += ak * c.mu * (c.h_min - t) * (c.h_min - t), dt -= 2 * ak * c.mu * (c.h_min - t);
-        if (on && t > c.h_max)
+        if (t > c.h_max)
           cost += ak * c.mu * (t - c.h_max) * (t - c.h_max), dt += 2 * ak * c.mu * (t - c.h_max);
         dS[i] += dt, dS[i + 1] -= dt;
       }
@@ -147,7 +147,7 @@ double printability_cost(const StackGrid& g, const Eigen::MatrixXd& Z, const Cos
       // Most layers are well under the limit: the square screens them (with room for its
       // rounding) before the exact hypot, which was a tenth of an evaluation.
       const double g2 = c.g * c.g * (1 - 1e-9);
-      for (int i = 1; on && i + 1 < L; ++i) {
+      for (int i = 1; i + 1 < L; ++i) {
         if (Sx[i] * Sx[i] + Sy[i] * Sy[i] <= g2) continue;
         const double sl = std::hypot(Sx[i], Sy[i]);
         if (sl > c.g) {

@@ -5,13 +5,14 @@
 // Notation: samples k on a grid over the stack's rectangle, area a_k; R_kj the rational basis
 // of control point j at sample k (all layers share knots and weights, so S_i(k) = Σ_j R_kj
 // z_ij and ∇S_i(k) = Σ_j ∇R_kj z_ij); t_ik = S_i(k) − S_{i+1}(k).
-//   C = Σ_k a_k [ m_k Σ_i (t_ik − h)²                       (eq. 1, squared: smooth)
-//               + m_k λ Σ_i |∇S_i − ∇S_{i+1}|²            (continuity)
-//               + μ Σ_i (max(0, h_min − t)² + max(0, t − h_max)²)
-//               + μ Σ_i max(0, |∇S_i| − g)² ]            (slope: g = tan α)
+//   C = Σ_k m_k a_k [ Σ_i (t_ik − h)²                       (eq. 1, squared: smooth)
+//                   + λ Σ_i |∇S_i − ∇S_{i+1}|²            (continuity)
+//                   + μ Σ_i (max(0, h_min − t)² + max(0, t − h_max)²)
+//                   + μ Σ_i max(0, |∇S_i| − g)² ]        (slope: g = tan α)
 //     + μ Σ_i Σ_(k,l) max(0, S_i(l) − S_i(k) − H)²          (heater block: pairs of samples
 //                                                              on the patch within radius R)
-// with m_k = 1 on the patch, 0 in the margin around it (limits hold there too).
+// with m_k = 1 on the patch, 0 in the margin around it: the limits there are the blend
+// check's (the fit off the patch can swing by millimetres), so such a sample costs nothing.
 #pragma once
 
 #include <Eigen/Core>
