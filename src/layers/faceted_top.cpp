@@ -65,6 +65,26 @@ void height_range(const TriangleMesh& mesh, const Patch& patch, double* lo, doub
     }
 }
 
+// One Gauss–Seidel sweep, row by row and down each row, over the nodes of ring 2 and up:
+// H = the mean of its four neighbours, the ones before it already this sweep's. Each update
+// waits for the one before it in its row, so kRows rows go side by side, each a node behind
+// the row before it: every node still reads the same values as in the plain row-by-row order
+// (the row above is past it, the row below not yet there), and the CPU overlaps the rows'
+// chains (the bunny's rasters of up to 2 million nodes, 20 sweeps each).
+void relax(std::vector<double>& mz, const std::vector<int>& ring, int nx, int ny) {
+  constexpr int kRows = 4;
+  const auto update = [&](int i, int j) {
+    const std::size_t q = static_cast<std::size_t>(i) * ny + j;
+    if (ring[q] >= 2) mz[q] = 0.25 * (mz[q - ny] + mz[q + ny] + mz[q - 1] + mz[q + 1]);
+  };
+  for (int i0 = 1; i0 + 1 < nx; i0 += kRows) {
+    const int rows = std::min(kRows, nx - 1 - i0);
+    for (int step = 1; step + 1 < ny + rows - 1; ++step)
+      for (int r = 0; r < rows; ++r)
+        if (const int j = step - r; j >= 1 && j + 1 < ny) update(i0 + r, j);
+  }
+}
+
 }  // namespace
 
 double FacetedTop::height(double x, double y) const {
@@ -188,13 +208,7 @@ FacetedTop faceted_top(const TriangleMesh& mesh, const Patch& patch, double cell
   }
   // Rings from different stretches of the rim meet in ridges: relax H off the patch towards
   // the mean of its neighbours (the patch and the first ring stay).
-  for (int sweep = 0; sweep < 20; ++sweep)
-    for (int i = 1; i + 1 < t.nx; ++i)
-      for (int j = 1; j + 1 < t.ny; ++j) {
-        const std::size_t q = static_cast<std::size_t>(i) * t.ny + j;
-        if (ring[q] < 2) continue;
-        mz[q] = 0.25 * (mz[q - t.ny] + mz[q + t.ny] + mz[q - 1] + mz[q + 1]);
-      }
+  for (int sweep = 0; sweep < 20; ++sweep) relax(mz, ring, t.nx, t.ny);
   t.h_lo = h_lo, t.h_hi = h_hi;
   t.h = std::move(mz);
   return t;
