@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 
 #include "nurbs/bspline_basis.hpp"
@@ -109,15 +110,20 @@ double Band::delta(double x, double y, double z, const PlanarLayers& pl) const {
 }
 
 double Band::delta(const Basis& b, double z, const PlanarLayers& pl) const {
+  return delta_from([&](int i) { return surface(b, i); }, z, pl);
+}
+
+template <class Surfaces>
+double Band::delta_from(const Surfaces& S, double z, const PlanarLayers& pl) const {
   if (z <= c) return 0.0;
-  const double S0 = surface(b, 0);
+  const double S0 = S(0);
   if (z <= S0) {
     // S decreases with i: binary search for S_i ≥ z ≥ S_{i+1}.
     int lo = 0, hi = N;  // S_lo ≥ z, S_hi = c < z
-    double Slo = S0, Shi = surface(b, N);
+    double Slo = S0, Shi = S(N);
     while (hi - lo > 1) {
       const int mid = (lo + hi) / 2;
-      const double Sm = surface(b, mid);
+      const double Sm = S(mid);
       if (Sm >= z)
         lo = mid, Slo = Sm;
       else
@@ -205,8 +211,21 @@ class BandedField::Column {
   double T(double z) const {
     if (field_) return field_->T(x_, y_, z);
     double t = pl_.T(z);
-    for (int k = 0; k < n_; ++k) t += scale_ * beta_[k] * band_[k]->delta(basis_[k], z, pl_);
+    for (int k = 0; k < n_; ++k) {
+      const Band& b = *band_[k];
+      const double d = b.N < kKept ? b.delta_from([&](int i) { return surface(k, i); }, z, pl_)
+                                   : b.delta(basis_[k], z, pl_);
+      t += scale_ * beta_[k] * d;
+    }
     return t;
+  }
+  /// Band k's S_i here, each evaluated once per column: a root takes some 15 evaluations of
+  /// T, each a binary search over the band's surfaces (9 of them for the bunny's 91 layers).
+  double surface(int k, int i) const {
+    std::uint64_t& word = known_[k][i / 64];
+    const std::uint64_t bit = std::uint64_t{1} << (i % 64);
+    if (!(word & bit)) kept_[k][i] = band_[k]->surface(basis_[k], i), word |= bit;
+    return kept_[k][i];
   }
   bool planar() const { return n_ == 0 && !field_; }
   /// The one band with β = 1 here when no other band reaches, else null.
@@ -218,6 +237,7 @@ class BandedField::Column {
 
  private:
   static constexpr int kMax = 8;
+  static constexpr int kKept = 256;  ///< bands of fewer layers keep their surfaces
   const PlanarLayers& pl_;
   const BandedField* field_ = nullptr;  ///< set when more than kMax bands overlap here
   double x_ = 0, y_ = 0, scale_ = 1;
@@ -225,6 +245,8 @@ class BandedField::Column {
   const Band* band_[kMax];
   double beta_[kMax];
   Band::Basis basis_[kMax];
+  mutable std::uint64_t known_[kMax][kKept / 64] = {};
+  mutable double kept_[kMax][kKept];
 };
 
 double BandedField::T(double x, double y, double z) const {

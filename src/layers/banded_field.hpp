@@ -54,6 +54,10 @@ struct Band {
   double delta(double x, double y, double z, const PlanarLayers& pl) const;
   /// δ at height z of the column whose basis is `b` (basis(x, y) computed once per column).
   double delta(const Basis& b, double z, const PlanarLayers& pl) const;
+  /// The same from the column's surfaces as S(i) gives them (= surface(b, i); a root-find
+  /// over one column keeps those it has evaluated). Defined in banded_field.cpp, used there.
+  template <class Surfaces>
+  double delta_from(const Surfaces& S, double z, const PlanarLayers& pl) const;
 };
 
 /// β control values from a patch raster: 1 within 3 nodes of the patch (so the B-spline is
