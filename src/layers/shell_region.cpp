@@ -97,29 +97,36 @@ std::vector<char> stands_above(const TriangleMesh& mesh, const std::vector<char>
 }
 
 // Chamfer distance (mm) from every node to the nearest marked one, two passes with steps of
-// one cell and a diagonal; +inf where nothing is marked.
+// one cell and a diagonal; +inf where nothing is marked. Each pass takes a row's three
+// neighbours in the row before it first (independent of each other), then runs along the row
+// (each node after the one before it); min is exact, so the order of the steps does not
+// change a value.
 std::vector<double> distance_to(const std::vector<char>& marked, const Raster& r) {
   const FacetedTop& t = r.t;
+  const int nx = t.nx, ny = t.ny;
   std::vector<double> d(marked.size(), std::numeric_limits<double>::infinity());
   for (std::size_t q = 0; q < marked.size(); ++q)
     if (marked[q]) d[q] = 0;
   const double s = t.cell, sd = t.cell * M_SQRT2;
-  auto relax = [&](int i, int j, int di, int dj, double w) {
-    const int i2 = i + di, j2 = j + dj;
-    if (i2 < 0 || j2 < 0 || i2 >= t.nx || j2 >= t.ny) return;
-    double& here = d[r.index(i, j)];
-    here = std::min(here, d[r.index(i2, j2)] + w);
+  // Row `to` from row `from` (its neighbour across), then along the row in direction dir.
+  auto pass_row = [&](int to, int from, int dir) {
+    double* row = &d[r.index(to, 0)];
+    if (from >= 0 && from < nx) {
+      const double* p = &d[r.index(from, 0)];
+      for (int j = 0; j < ny; ++j) {
+        double v = std::min(row[j], p[j] + s);
+        if (j > 0) v = std::min(v, p[j - 1] + sd);
+        if (j + 1 < ny) v = std::min(v, p[j + 1] + sd);
+        row[j] = v;
+      }
+    }
+    if (dir > 0)
+      for (int j = 1; j < ny; ++j) row[j] = std::min(row[j], row[j - 1] + s);
+    else
+      for (int j = ny - 2; j >= 0; --j) row[j] = std::min(row[j], row[j + 1] + s);
   };
-  for (int i = 0; i < t.nx; ++i)
-    for (int j = 0; j < t.ny; ++j) {
-      relax(i, j, -1, 0, s), relax(i, j, 0, -1, s);
-      relax(i, j, -1, -1, sd), relax(i, j, -1, 1, sd);
-    }
-  for (int i = t.nx - 1; i >= 0; --i)
-    for (int j = t.ny - 1; j >= 0; --j) {
-      relax(i, j, 1, 0, s), relax(i, j, 0, 1, s);
-      relax(i, j, 1, 1, sd), relax(i, j, 1, -1, sd);
-    }
+  for (int i = 0; i < nx; ++i) pass_row(i, i - 1, 1);
+  for (int i = nx - 1; i >= 0; --i) pass_row(i, i + 1, -1);
   return d;
 }
 
