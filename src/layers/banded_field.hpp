@@ -81,6 +81,11 @@ class BandedField final : public LayerField {
   /// False when the segment crosses a band's support box within the layers it bends.
   bool planar_along(const Vec2& a, const Vec2& b, double t_lo, double t_hi) const override;
   const std::vector<Band>& bands() const { return bands_; }
+  /// The bands, moved out: the field is left with none (to build one without a band).
+  std::vector<Band> take_bands() {
+    reach_.clear();
+    return std::move(bands_);
+  }
   const PlanarLayers& planar() const { return pl_; }
   /// z_at for n layer coordinates t[0..n), increasing, on one vertical line, each within tol
   /// (mm) of the exact root; each bracket starts from the root below it. For a check over
