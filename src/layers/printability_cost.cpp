@@ -145,8 +145,9 @@ double printability_cost(const StackGrid& g, const Eigen::MatrixXd& Z, const Cos
       // stacks on 12 real parts). Limits are the stack's over the patch, as the stack's
       // figures measure them; the blend check judges the layers round it.
       // Most layers are well under the limit: the square screens them (with room for its
-      // rounding) before the exact hypot, which was a tenth of an evaluation.
-      const double g2 = c.g * c.g * (1 - 1e-9);
+      // rounding) before the exact hypot, which was a tenth of an evaluation. (g < 0, under
+      // 0.6° max_angle: nothing is screened.)
+      const double g2 = c.g > 0 ? c.g * c.g * (1 - 1e-9) : -1.0;
       for (int i = 1; i + 1 < L; ++i) {
         if (Sx[i] * Sx[i] + Sy[i] * Sy[i] <= g2) continue;
         const double sl = std::hypot(Sx[i], Sy[i]);

@@ -55,5 +55,50 @@ TEST(PrintabilityCost, GradientMatchesFiniteDifferences) {
   EXPECT_LT(worst, 1e-5 * scale);
 }
 
+// The slope term against a sum worked out here from the grid's basis: with g < 0 (a limit
+// under 0.6°) every intermediate layer on the patch pays μ a_k (|∇S_i| − g)²; with a limit
+// no layer reaches, none does. Off the patch nothing is paid.
+TEST(PrintabilityCost, SlopeTermOverEveryLayerBelowANegativeLimit) {
+  const TriangleMesh m = test::height_field_solid(
+      [](double x, double y) { return 6 + 0.8 * std::sin(x / 3) * std::cos(y / 4); }, 0, 12, 0, 10,
+      24, 20);
+  const Analysis a = *analyze(m, {}, {});
+  FitParams fp;
+  fp.max_control = 7;
+  const SurfaceFit fit = *fit_patch(m, a.patches[0], fp, {});
+  const layers::PatchRaster r = layers::rasterize_patch(m, a.patches[0], 0.25, 0.0);
+  layers::StackGrid g;
+  layers::build_stack_grid(g, fit.surface, 1.0, r.mask, r.origin, r.cell, r.nx, r.ny);
+  const int nc = fit.surface.surface.n_u * fit.surface.surface.n_v, N = 4;
+  Eigen::MatrixXd Z(N + 1, nc);
+  for (int i = 0; i <= N; ++i)
+    for (int j = 0; j < nc; ++j)
+      Z(i, j) = (1.0 - i / 4.0) * fit.surface.surface.points[j].z() + i / 4.0 * 3.0;
+  const double mu = 10.0, g_neg = -0.01;
+  const layers::CostTerms loose{0.2, 0.1, 0.3, 0.05, mu, 1e6};
+  const layers::CostTerms tight{0.2, 0.1, 0.3, 0.05, mu, g_neg};
+  double expected = 0;
+  int on = 0;
+  for (std::size_t k = 0; k < g.xy.size(); ++k) {
+    if (!g.on_patch[k]) continue;
+    ++on;
+    for (int i = 1; i < N; ++i) {
+      double sx = 0, sy = 0;
+      for (int c = 0; c < g.m; ++c) {
+        sx += g.Rx[k * g.m + c] * Z(i, g.control(static_cast<int>(k), c));
+        sy += g.Ry[k * g.m + c] * Z(i, g.control(static_cast<int>(k), c));
+      }
+      const double over = std::hypot(sx, sy) - g_neg;
+      expected += g.area[k] * mu * over * over;
+    }
+  }
+  ASSERT_GT(on, 20);
+  ASSERT_LT(on, static_cast<int>(g.xy.size()));  // some samples lie off the patch
+  const double paid = layers::printability_cost(g, Z, tight, nullptr) -
+                      layers::printability_cost(g, Z, loose, nullptr);
+  EXPECT_GT(expected, 1.0);
+  EXPECT_NEAR(paid, expected, 1e-9 * expected);
+}
+
 }  // namespace
 }  // namespace nonplanar
