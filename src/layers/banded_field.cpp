@@ -219,8 +219,9 @@ class BandedField::Column {
     }
     return t;
   }
-  /// Band k's S_i here, each evaluated once per column: a root takes some 15 evaluations of
-  /// T, each a binary search over the band's surfaces (9 of them for the bunny's 91 layers).
+  /// Band k's S_i here, each evaluated once per column: a root takes about 5 evaluations of
+  /// T, each a binary search over the band's surfaces (9 of them for the bunny's 91 layers),
+  /// mostly the same few.
   double surface(int k, int i) const {
     std::uint64_t& word = known_[k][i / 64];
     const std::uint64_t bit = std::uint64_t{1} << (i % 64);
