@@ -9,22 +9,37 @@
 namespace nonplanar {
 namespace {
 
-// The analytic gradient of the cost against central differences, on a stack whose terms
-// are all active: thickness outside the limits, steep layers, a tight heater clearance.
-TEST(PrintabilityCost, GradientMatchesFiniteDifferences) {
+// A 12 × 10 mm sine bump's patch, its fitted top (at most 7 controls a side) and the cost's
+// grid over the patch's rectangle at 1 mm.
+struct Bump {
+  SurfaceFit fit;
+  layers::StackGrid grid;
+  int controls = 0;
+};
+Bump bump(double amplitude) {
   const TriangleMesh m = test::height_field_solid(
-      [](double x, double y) { return 6 + std::sin(x / 3) * std::cos(y / 4); }, 0, 12, 0, 10, 24,
-      20);
+      [amplitude](double x, double y) { return 6 + amplitude * std::sin(x / 3) * std::cos(y / 4); },
+      0, 12, 0, 10, 24, 20);
   const Analysis a = *analyze(m, {}, {});
   FitParams fp;
   fp.max_control = 7;
-  const SurfaceFit fit = *fit_patch(m, a.patches[0], fp, {});
+  Bump b;
+  b.fit = *fit_patch(m, a.patches[0], fp, {});
   const layers::PatchRaster r = layers::rasterize_patch(m, a.patches[0], 0.25, 0.0);
-  layers::StackGrid g;
-  layers::build_stack_grid(g, fit.surface, 1.0, r.mask, r.origin, r.cell, r.nx, r.ny);
+  layers::build_stack_grid(b.grid, b.fit.surface, 1.0, r.mask, r.origin, r.cell, r.nx, r.ny);
+  b.controls = b.fit.surface.surface.n_u * b.fit.surface.surface.n_v;
+  return b;
+}
+
+// The analytic gradient of the cost against central differences, on a stack whose terms
+// are all active: thickness outside the limits, steep layers, a tight heater clearance.
+TEST(PrintabilityCost, GradientMatchesFiniteDifferences) {
+  Bump b = bump(1.0);
+  const SurfaceFit& fit = b.fit;
+  layers::StackGrid& g = b.grid;
   g.pair_within(3.0, 1.0);
   ASSERT_FALSE(g.block_pairs.empty());
-  const int nc = fit.surface.surface.n_u * fit.surface.surface.n_v;
+  const int nc = b.controls;
   const int N = 5;
   Eigen::MatrixXd Z(N + 1, nc);
   std::mt19937 rng(4);
@@ -59,17 +74,10 @@ TEST(PrintabilityCost, GradientMatchesFiniteDifferences) {
 // under 0.6°) every intermediate layer on the patch pays μ a_k (|∇S_i| − g)²; with a limit
 // no layer reaches, none does. Off the patch nothing is paid.
 TEST(PrintabilityCost, SlopeTermOverEveryLayerBelowANegativeLimit) {
-  const TriangleMesh m = test::height_field_solid(
-      [](double x, double y) { return 6 + 0.8 * std::sin(x / 3) * std::cos(y / 4); }, 0, 12, 0, 10,
-      24, 20);
-  const Analysis a = *analyze(m, {}, {});
-  FitParams fp;
-  fp.max_control = 7;
-  const SurfaceFit fit = *fit_patch(m, a.patches[0], fp, {});
-  const layers::PatchRaster r = layers::rasterize_patch(m, a.patches[0], 0.25, 0.0);
-  layers::StackGrid g;
-  layers::build_stack_grid(g, fit.surface, 1.0, r.mask, r.origin, r.cell, r.nx, r.ny);
-  const int nc = fit.surface.surface.n_u * fit.surface.surface.n_v, N = 4;
+  const Bump b = bump(0.8);
+  const SurfaceFit& fit = b.fit;
+  const layers::StackGrid& g = b.grid;
+  const int nc = b.controls, N = 4;
   Eigen::MatrixXd Z(N + 1, nc);
   for (int i = 0; i <= N; ++i)
     for (int j = 0; j < nc; ++j)
