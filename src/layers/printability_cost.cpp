@@ -35,7 +35,6 @@ void build_stack_grid(StackGrid& g, const HeightField& hf, double step,
                       double raster_cell, int raster_nx, int raster_ny) {
   const NurbsSurface& s = hf.surface;
   g = StackGrid{};
-  g.n_u = s.n_u, g.n_v = s.n_v, g.q = s.q;
   g.m = (s.p + 1) * (s.q + 1);
   const int nx = std::max(2, static_cast<int>(std::ceil(hf.extent.x() / step)));
   const int ny = std::max(2, static_cast<int>(std::ceil(hf.extent.y() / step)));
@@ -57,7 +56,6 @@ void build_stack_grid(StackGrid& g, const HeightField& hf, double step,
       const int sv = nurbs::find_span(s.n_v, s.q, uv.y(), s.V);
       nurbs::ders_basis_funs(su, uv.x(), s.p, 1, s.U, du.data());
       nurbs::ders_basis_funs(sv, uv.y(), s.q, 1, s.V, dv.data());
-      g.first.push_back((su - s.p) * s.n_v + (sv - s.q));
       for (int a = 0; a <= s.p; ++a)
         for (int c = 0; c <= s.q; ++c) g.ctrl.push_back((su - s.p + a) * s.n_v + (sv - s.q + c));
       // Rational basis R = N w / W and its derivatives (quotient rule), in x and y.

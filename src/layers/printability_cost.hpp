@@ -27,11 +27,9 @@ struct StackGrid {
   std::vector<double> area;
   std::vector<char> on_patch;
   int m = 0;                      ///< basis functions per sample, (p+1)(q+1)
-  std::vector<int> first;         ///< per sample: (i0, j0) of its span as i0·n_v + j0
   std::vector<int> ctrl;          ///< m per sample: control index of each basis function
   std::vector<double> R, Rx, Ry;  ///< m per sample: basis, ∂/∂x, ∂/∂y
-  int n_u = 0, n_v = 0, q = 0;
-  int nx = 0, ny = 0;  ///< sample k = i·ny + j at (i + ½, j + ½)·step
+  int nx = 0, ny = 0;             ///< sample k = i·ny + j at (i + ½, j + ½)·step
   double step_x = 0, step_y = 0;
   std::vector<std::pair<int, int>> block_pairs;  ///< (k, l): l within the block radius of k
 
