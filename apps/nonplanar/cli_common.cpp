@@ -1,5 +1,6 @@
 #include "cli_common.hpp"
 
+#include <malloc.h>
 #include <sys/resource.h>
 #include <sys/time.h>
 #include <unistd.h>
@@ -9,6 +10,7 @@
 #include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <stdexcept>
@@ -86,7 +88,30 @@ void add_limit_options(CLI::App& app, Limits& l) {
       ->check(CLI::Range(0.0, 1e7));
 }
 
+namespace {
+// glibc's allocator, tuned for a run that allocates and frees rasters and grids of a few MB
+// over and over (a shell's planning makes a dozen per candidate): by default each of them is
+// mapped afresh and every page of it faults in, 11 % of the airfoil's samples in the kernel.
+// Blocks up to 4 MB now come from the heap, which keeps what is freed (up to 512 MB) and grows
+// 64 MB at a time (address space: not under --max-memory, where it would eat the margin).
+// Airfoil 0.90 of its wall time before, car 0.91, wave roof 0.97, bunny 0.95 with the same
+// peak (205 MB). MALLOC_*_ in the environment (glibc's own knobs) leave the defaults alone.
+void tune_allocator(bool memory_limited) {
+#if defined(__GLIBC__) && !defined(NONPLANAR_SHADOW_MEMORY)
+  for (const char* knob : {"MALLOC_MMAP_THRESHOLD_", "MALLOC_TRIM_THRESHOLD_", "MALLOC_TOP_PAD_"})
+    if (std::getenv(knob)) return;
+  mallopt(M_MMAP_THRESHOLD, 4 << 20);
+  mallopt(M_TRIM_THRESHOLD, 512 << 20);
+  if (!memory_limited) mallopt(M_TOP_PAD, 64 << 20);
+#else
+  (void)memory_limited;
+#endif
+}
+
+}  // namespace
+
 bool install_limits(const Limits& l) {
+  tune_allocator(l.max_memory_mb > 0);
   g_max_memory = l.max_memory_mb, g_max_time = l.max_time_s;
   if (l.max_memory_mb > 0) {
 #if defined(NONPLANAR_SHADOW_MEMORY)
