@@ -1,12 +1,14 @@
 // Stack construction plus optimisation for one 50 × 50 mm patch (issue 4 target: <= 0.5 s),
-// one evaluation of its optimiser's cost and gradient, the normalisation of its mesh, and a
-// whole slice that prints as a shell.
+// one evaluation of its optimiser's cost and gradient, the normalisation of its mesh, a
+// whole slice that prints as a shell, and the choice of a shell's print heights.
 #include <benchmark/benchmark.h>
 
 #include <cmath>
+#include <vector>
 
 #include "layers/patch_raster.hpp"
 #include "layers/printability_cost.hpp"
+#include "layers/shell_levels.hpp"
 #include "nonplanar/deform.hpp"
 #include "nonplanar/layers.hpp"
 #include "nonplanar/pipeline.hpp"
@@ -91,9 +93,24 @@ void BM_SliceRibShell(benchmark::State& state) {
   }
 }
 
+// The heights a shell beside a rim prints at (layers/shell_levels.hpp): 200 000 nodes of a
+// 20 mm ramp, each printable up to 0.5 mm after its height, 8 levels over 1000 bins.
+void BM_ChooseLevels(benchmark::State& state) {
+  std::vector<double> u, lo, hi;
+  for (int k = 0; k < 200000; ++k) {
+    const double h = 20.0 * k / 199999;
+    u.push_back(h), lo.push_back(h - 0.05), hi.push_back(h + 0.5);
+  }
+  for (auto _ : state) {
+    const auto c = nonplanar::layers::choose_levels(u, lo, hi, 8);
+    state.counters["banded"] = c.banded;
+  }
+}
+
 BENCHMARK(BM_PlanLayers50mm)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_PrintabilityCost)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_NormalizeMesh50mm)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_SliceRibShell)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_ChooseLevels)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace

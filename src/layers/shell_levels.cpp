@@ -37,36 +37,36 @@ LevelChoice choose_levels(const std::vector<double>& u, const std::vector<double
   }
   for (auto& v : his) std::sort(v.begin(), v.end());
   for (std::size_t b = 1; b < top_lo.size(); ++b) top_lo[b] = std::max(top_lo[b], top_lo[b - 1]);
-  // below[b][a]: the nodes of bins < a that top_lo[b] lies within (hi >= it), so the range of
-  // bins a … b holds below[b][b + 1] − below[b][a] of them.
-  const auto W = static_cast<std::size_t>(B) + 1;
-  std::vector<int> below(static_cast<std::size_t>(B) * W, 0);
-  for (int b = 0; b < B; ++b) {
-    int* row = &below[static_cast<std::size_t>(b) * W];
-    const double z = top_lo[static_cast<std::size_t>(b)];
-    for (int a = 0; a < B; ++a) {
-      const auto& h = his[static_cast<std::size_t>(a)];
-      row[a + 1] = row[a] + static_cast<int>(h.end() - std::lower_bound(h.begin(), h.end(), z));
-    }
-  }
-  auto count = [&](int a, int b) {
-    const int* row = &below[static_cast<std::size_t>(b) * W];
-    return row[b + 1] - row[a];
-  };
   // best[L][b + 1]: the most nodes within their level with L ranges over bins 0 … b; from[L][b + 1]
-  // the first bin of the last range.
+  // the first bin of the last range. A range a … b holds count(a, b) = row[b + 1] − row[a] of
+  // its nodes, row[a] the nodes of bins < a that top_lo[b] lies within (hi >= it); row is made
+  // for one b at a time, its bins' lower bounds moving up with top_lo (non-decreasing), so the
+  // work is O(B²) without a B × B table (4 MB at B = 1000, written afresh for each shell).
+  const auto W = static_cast<std::size_t>(B) + 1;
   const auto L_max = static_cast<std::size_t>(max_levels);
   std::vector<std::vector<int>> best(L_max + 1, std::vector<int>(W, 0)), from = best;
-  for (int b = 0; b < B; ++b) best[1][static_cast<std::size_t>(b) + 1] = count(0, b);
-  for (std::size_t L = 2; L <= L_max; ++L)
-    for (int b = 0; b < B; ++b) {
-      const auto e = static_cast<std::size_t>(b) + 1;
+  std::vector<int> row(W, 0);
+  std::vector<std::size_t> first_within(static_cast<std::size_t>(B), 0);
+  for (int b = 0; b < B; ++b) {
+    const double z = top_lo[static_cast<std::size_t>(b)];
+    for (int a = 0; a <= b; ++a) {
+      const auto& h = his[static_cast<std::size_t>(a)];
+      std::size_t& k = first_within[static_cast<std::size_t>(a)];
+      while (k < h.size() && h[k] < z) ++k;
+      row[static_cast<std::size_t>(a) + 1] =
+          row[static_cast<std::size_t>(a)] + static_cast<int>(h.size() - k);
+    }
+    const int* r = row.data();
+    const auto e = static_cast<std::size_t>(b) + 1;
+    best[1][e] = r[b + 1] - r[0];
+    for (std::size_t L = 2; L <= L_max; ++L) {
       best[L][e] = best[L - 1][e], from[L][e] = from[L - 1][e];
       for (int a = 1; a <= b; ++a) {
-        const int v = best[L - 1][static_cast<std::size_t>(a)] + count(a, b);
+        const int v = best[L - 1][static_cast<std::size_t>(a)] + r[b + 1] - r[a];
         if (v > best[L][e]) best[L][e] = v, from[L][e] = a;
       }
     }
+  }
   // As few levels as come within 2 % of the most: each is printed apart, like a band.
   std::size_t L = 1;
   const auto end = static_cast<std::size_t>(B);
