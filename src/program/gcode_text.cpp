@@ -41,25 +41,28 @@ void GcodeText::line(const char* fmt, ...) {
   raw(buf);
 }
 
+// Straight into `out`: a line in a string of its own was an allocation a move (longer than
+// the string's inline room), 700 000 of them for the bunny.
 void GcodeText::move(const ProgramMove& m) {
-  std::string s = "G1";
+  const std::size_t start = out.size();
+  out += "G1";
   bool fits = true;
-  if (m.xy) fits = word(s, 'X', m.to.x(), 3) && word(s, 'Y', m.to.y(), 3);
-  if (m.z) fits = fits && word(s, 'Z', m.to.z(), 3);
+  if (m.xy) fits = word(out, 'X', m.to.x(), 3) && word(out, 'Y', m.to.y(), 3);
+  if (m.z) fits = fits && word(out, 'Z', m.to.z(), 3);
   if (!std::isnan(m.de)) {
     e_ += m.de;
-    fits = fits && word(s, 'E', rel_e_ ? m.de : e_, 5);
+    fits = fits && word(out, 'E', rel_e_ ? m.de : e_, 5);
   }
   if (!std::isnan(m.f)) {
     char buf[32];
     const double f = std::round(m.f);
     fits = fits && std::abs(f) < 2e9;
     if (fits) std::snprintf(buf, sizeof buf, " F%d", static_cast<int>(f));
-    if (fits) s += buf;
+    if (fits) out += buf;
   }
-  if (m.comment) s += std::string(" ; ") + m.comment;
-  if ((!fits || s.size() > 255) && !fault) fault = line_too_long();
-  raw(s);
+  if (m.comment) out.append(" ; ").append(m.comment);
+  if ((!fits || out.size() - start > 255) && !fault) fault = line_too_long();
+  out.push_back('\n');
 }
 
 void write_program_layer(GcodeText& w, const ProgramLayer& layer) {
