@@ -92,17 +92,20 @@ namespace {
 // glibc's allocator, tuned for a run that allocates and frees rasters and grids of a few MB
 // over and over (a shell's planning makes a dozen per candidate): by default each of them is
 // mapped afresh and every page of it faults in, 11 % of the airfoil's samples in the kernel.
-// Blocks up to 4 MB now come from the heap, which keeps what is freed (up to 512 MB) and grows
-// 64 MB at a time (address space: not under --max-memory, where it would eat the margin).
-// Airfoil 0.90 of its wall time before, car 0.91, wave roof 0.97, bunny 0.95 with the same
-// peak (205 MB). MALLOC_*_ in the environment (glibc's own knobs) leave the defaults alone.
+// Blocks up to 4 MB now come from the heap, which keeps up to 16 MB free at its top and grows
+// 16 MB at a time (address space: not under --max-memory, where it would eat the margin).
+// Against glibc's defaults (farm-bench, with 2a5bf3b): airfoil 0.85 of its wall time, car 0.91,
+// the bunny 0.97 with a lower peak (192 MB against 209); Benchy 1.10 (103 MB against 106).
+// Keeping 512 MB and growing 64 MB was faster on Benchy (1.43 s against 1.59) but raised its
+// peak to 136 MB, over PrusaSlicer's. MALLOC_*_ in the environment (glibc's own knobs) leave
+// the defaults.
 void tune_allocator(bool memory_limited) {
 #if defined(__GLIBC__) && !defined(NONPLANAR_SHADOW_MEMORY)
   for (const char* knob : {"MALLOC_MMAP_THRESHOLD_", "MALLOC_TRIM_THRESHOLD_", "MALLOC_TOP_PAD_"})
     if (std::getenv(knob)) return;
   mallopt(M_MMAP_THRESHOLD, 4 << 20);
-  mallopt(M_TRIM_THRESHOLD, 512 << 20);
-  if (!memory_limited) mallopt(M_TOP_PAD, 64 << 20);
+  mallopt(M_TRIM_THRESHOLD, 16 << 20);
+  if (!memory_limited) mallopt(M_TOP_PAD, 16 << 20);
 #else
   (void)memory_limited;
 #endif
