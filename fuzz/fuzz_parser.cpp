@@ -18,6 +18,7 @@
 
 #if NONPLANAR_FUZZ_PARSER == 8
 #include <cmath>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -50,6 +51,8 @@ struct Waves final : nonplanar::LayerClip {
 #if NONPLANAR_FUZZ_PARSER == 10
 #include <cmath>
 #include <cstdlib>
+#include <set>
+#include <string>
 
 #include "nonplanar/gcode.hpp"
 #include "nonplanar/slice.hpp"
@@ -65,10 +68,29 @@ nonplanar::TriangleMesh settings_box(const nonplanar::Vec2& mid) {
   return m;
 }
 
+// The code (before any comment, trailing blanks off) of a line.
+std::string code_of(const std::string& line) {
+  std::string code = line.substr(0, line.find(';'));
+  while (!code.empty() && (code.back() == ' ' || code.back() == '\t' || code.back() == '\r'))
+    code.pop_back();
+  return code;
+}
+
 // Traps on a line the printer should never get: over 255 characters, a feed rate outside
-// (0, 60000] mm/min, a fan value outside 0…255, a non-finite number; or a move of the print
-// (from its first extrusion to its last) off the bed.
+// (0, 60000] mm/min (but in the profile's own blocks), a fan value outside 0…255, a non-finite
+// number; or a move of the print (from its first extrusion to its last) off the bed.
 void check_settings_output(const std::string& text, const nonplanar::PrintConfig& c) {
+  // The profile's own G-code blocks pass as written, as PrusaSlicer passes them: a start G-code
+  // "G1 Z5 F0000" (a mutated F5000) is the user's line, not one this program made.
+  std::set<std::string> custom;
+  for (const std::string* block :
+       {&c.gcode.start_gcode, &c.gcode.end_gcode, &c.gcode.before_layer_gcode, &c.gcode.layer_gcode,
+        &c.gcode.start_filament_gcode, &c.gcode.end_filament_gcode})
+    for (std::size_t p = 0; p < block->size();) {
+      const std::size_t e = std::min(block->find('\n', p), block->size());
+      custom.insert(code_of(block->substr(p, e - p)));
+      p = e + 1;
+    }
   for (std::size_t p = 0; p < text.size();) {
     const std::size_t e = std::min(text.find('\n', p), text.size());
     const std::string line = text.substr(p, e - p);
@@ -82,7 +104,7 @@ void check_settings_output(const std::string& text, const nonplanar::PrintConfig
     if (command && code.rfind("M117", 0) != 0 && code.rfind("M118", 0) != 0 &&
         (code.find("nan") != std::string::npos || code.find("inf") != std::string::npos))
       __builtin_trap();
-    if (line.rfind("G1 ", 0) == 0 || line.rfind("G0 ", 0) == 0)
+    if ((line.rfind("G1 ", 0) == 0 || line.rfind("G0 ", 0) == 0) && !custom.count(code_of(line)))
       if (const auto f = line.find(" F"); f != std::string::npos) {
         const double v = std::strtod(line.c_str() + f + 2, nullptr);
         if (!(v > 0 && v <= 60000)) __builtin_trap();
