@@ -18,7 +18,6 @@
 
 #if NONPLANAR_FUZZ_PARSER == 8
 #include <cmath>
-#include <set>
 #include <string>
 #include <vector>
 
@@ -100,11 +99,11 @@ void check_settings_output(const std::string& text, const nonplanar::PrintConfig
                          line.rfind("G92 ", 0) == 0 || line.rfind("M1", 0) == 0;
     // Numbers only: a comment may say anything ("; solid_infill_speed = 15" in an end G-code
     // once tripped this), and M117/M118 carry text.
-    const std::string code = line.substr(0, line.find(';'));
+    const std::string code = code_of(line);
     if (command && code.rfind("M117", 0) != 0 && code.rfind("M118", 0) != 0 &&
         (code.find("nan") != std::string::npos || code.find("inf") != std::string::npos))
       __builtin_trap();
-    if ((line.rfind("G1 ", 0) == 0 || line.rfind("G0 ", 0) == 0) && !custom.count(code_of(line)))
+    if ((line.rfind("G1 ", 0) == 0 || line.rfind("G0 ", 0) == 0) && !custom.count(code))
       if (const auto f = line.find(" F"); f != std::string::npos) {
         const double v = std::strtod(line.c_str() + f + 2, nullptr);
         if (!(v > 0 && v <= 60000)) __builtin_trap();

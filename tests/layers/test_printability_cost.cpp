@@ -14,7 +14,7 @@ namespace {
 struct Bump {
   SurfaceFit fit;
   layers::StackGrid grid;
-  int controls = 0;
+  int controls() const { return fit.surface.surface.n_u * fit.surface.surface.n_v; }
 };
 Bump bump(double amplitude) {
   const TriangleMesh m = test::height_field_solid(
@@ -27,7 +27,6 @@ Bump bump(double amplitude) {
   b.fit = *fit_patch(m, a.patches[0], fp, {});
   const layers::PatchRaster r = layers::rasterize_patch(m, a.patches[0], 0.25, 0.0);
   layers::build_stack_grid(b.grid, b.fit.surface, 1.0, r.mask, r.origin, r.cell, r.nx, r.ny);
-  b.controls = b.fit.surface.surface.n_u * b.fit.surface.surface.n_v;
   return b;
 }
 
@@ -39,7 +38,7 @@ TEST(PrintabilityCost, GradientMatchesFiniteDifferences) {
   layers::StackGrid& g = b.grid;
   g.pair_within(3.0, 1.0);
   ASSERT_FALSE(g.block_pairs.empty());
-  const int nc = b.controls;
+  const int nc = b.controls();
   const int N = 5;
   Eigen::MatrixXd Z(N + 1, nc);
   std::mt19937 rng(4);
@@ -77,7 +76,7 @@ TEST(PrintabilityCost, SlopeTermOverEveryLayerBelowANegativeLimit) {
   const Bump b = bump(0.8);
   const SurfaceFit& fit = b.fit;
   const layers::StackGrid& g = b.grid;
-  const int nc = b.controls, N = 4;
+  const int nc = b.controls(), N = 4;
   Eigen::MatrixXd Z(N + 1, nc);
   for (int i = 0; i <= N; ++i)
     for (int j = 0; j < nc; ++j)
