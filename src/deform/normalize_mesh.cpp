@@ -58,6 +58,28 @@ RoundEdges round_edges(const TriangleMesh& m, const std::vector<char>& final_fac
   return r;
 }
 
+// Per edge of `r`: the largest |n_z| of the unit normals of its faces as mapped (`image`), 1
+// for a face of no area. A wall takes the map's error in z across its plane only that much:
+// the distance between the mapped mesh and the exact map is dz · |n_z|, and a steep wall's
+// section moves by it, not by dz (the sphere's normalised mesh had 8 times its faces).
+std::vector<float> flatness(const TriangleMesh& m, const std::vector<Vec3>& image,
+                            const std::vector<char>& final_face, const RoundEdges& r) {
+  std::vector<float> flat(r.edges.size(), 0.0f);
+  for (std::size_t fi = 0; fi < m.faces.size(); ++fi) {
+    if (final_face[fi]) continue;
+    const auto& f = m.faces[fi];
+    const Vec3 n = (image[f[1]] - image[f[0]]).cross(image[f[2]] - image[f[0]]);
+    const double len = n.norm();
+    const float nz = len > 0 ? static_cast<float>(std::abs(n.z()) / len) : 1.0f;
+    for (std::size_t k = 0; k < 3; ++k) {
+      const int e = r.corner_edge[3 * fi + k];
+      if (e >= 0)
+        flat[static_cast<std::size_t>(e)] = std::max(flat[static_cast<std::size_t>(e)], nz);
+    }
+  }
+  return flat;
+}
+
 // Corners of non-final faces on an edge of a final face (outside the care box): settled, so
 // the edge stays whole for both (conforming: no crack for the slicer).
 std::vector<char> settled_by_final(const TriangleMesh& m, const std::vector<char>& final_face) {
@@ -122,6 +144,7 @@ Expected<NormalizedMesh> normalize_mesh(const TriangleMesh& mesh, const LayerFie
     // Decide per edge once; the midpoint index is shared by both faces (conforming).
     RoundEdges round_e = round_edges(m, final_face, settled);
     const std::vector<std::pair<int, int>>& edges = round_e.edges;
+    const std::vector<float> flat = flatness(m, image, final_face, round_e);
     std::vector<Vec3> im(edges.size());
     std::vector<char> split_it(edges.size());
     core::parallel_for(std::size_t{0}, edges.size(), [&](std::size_t e) {
@@ -131,7 +154,10 @@ Expected<NormalizedMesh> normalize_mesh(const TriangleMesh& mesh, const LayerFie
       // Long edges in a curved region are split regardless: a midpoint on the chord does
       // not prove the whole edge maps straight.
       const bool long_curved = im[e].z() != pm.z() && (m.vertices[a] - m.vertices[b]).norm() > 2.0;
-      split_it[e] = long_curved || (im[e] - 0.5 * (image[a] + image[b])).norm() > params.tolerance;
+      // The map moves a point only in z: the exact midpoint lies dz above the chord, and
+      // dz · |n_z| from the faces' planes.
+      const double dz = std::abs(im[e].z() - 0.5 * (image[a].z() + image[b].z()));
+      split_it[e] = long_curved || dz * flat[e] > params.tolerance;
     });
     // Refused before the round is built when it would leave too many faces (a face with n
     // edges split becomes n + 1): Benchy's shell built its 900 000th face for nothing.

@@ -82,5 +82,65 @@ TEST(NormalizeMesh, TheFaceLimitIsTheCountTheRoundsWouldLeave) {
   EXPECT_NE(refused.error().message.find("more than"), std::string::npos);
 }
 
+// The mapped mesh lies within the tolerance of the exact map, measured as a distance: the map
+// moves points in z only, so a point of a face's preimage maps dz off the face and dz·|n_z| from
+// its plane. Sampled at the edges' midpoints (what the rounds test) and the faces' centroids,
+// over the bump's curved band.
+TEST(NormalizeMesh, TheMappedMeshLiesWithinTheToleranceOfTheExactMap) {
+  const TriangleMesh sphere = test::icosphere(Vec3(0, 0, 8), 9, 2);
+  const layers::ShellPlan plan = bump_plan();
+  const layers::ShellField field(plan);
+  const NormalizeParams params;
+  auto n = normalize_mesh(sphere, field, params, {});
+  ASSERT_TRUE(n);
+  auto image = [&](const Vec3& p) {
+    return Vec3(p.x(), p.y(), field.zeta(field.T(p.x(), p.y(), p.z())));
+  };
+  auto preimage = [&](const Vec3& q) {
+    return Vec3(q.x(), q.y(), field.z_at(q.x(), q.y(), field.t_of_zeta(q.z())));
+  };
+  double at_edges = 0, inside = 0;
+  for (const auto& f : n->mesh.faces) {
+    const Vec3 A = n->mesh.vertices[f[0]], B = n->mesh.vertices[f[1]], C = n->mesh.vertices[f[2]];
+    const Vec3 nrm = (B - A).cross(C - A).normalized();
+    const Vec3 a = preimage(A), b = preimage(B), c = preimage(C);
+    const Vec3 probes[4] = {0.5 * (a + b), 0.5 * (b + c), 0.5 * (c + a), (a + b + c) / 3.0};
+    for (int k = 0; k < 4; ++k) {
+      double& worst = k < 3 ? at_edges : inside;
+      worst = std::max(worst, std::abs((image(probes[k]) - A).dot(nrm)));
+    }
+  }
+  // The rounds test the edges (both faces' planes); a face's inside is not tested, and on this
+  // bump's raster (bilinear between 0.1 mm nodes) it strays a little farther.
+  EXPECT_LE(at_edges, params.tolerance + 1e-9);
+  EXPECT_LE(inside, 1.2 * params.tolerance);
+  EXPECT_GT(at_edges, 0.5 * params.tolerance);  // split no further than it needs
+}
+
+// A wall keeps its faces through the band: its image stays in its vertical plane (n_z = 0),
+// so the map's error in z moves none of its sections. Only the rule for long edges splits it
+// (every edge over 2 mm in a curved region). A box 12 mm wide through the bump's
+// band, its walls in faces of 1.5 mm sides (diagonals 2.1 mm).
+TEST(NormalizeMesh, AWallIsSplitOnlyForItsLongEdges) {
+  const TriangleMesh box = test::subdivide(test::box(Vec3(-6, -6, 0), Vec3(6, 6, 16)), 3);
+  const layers::ShellPlan plan = bump_plan();
+  const layers::ShellField field(plan);
+  auto n = normalize_mesh(box, field, {}, {});
+  ASSERT_TRUE(n);
+  auto walls = [](const TriangleMesh& m) {
+    std::size_t count = 0;
+    for (const auto& f : m.faces) {
+      const Vec3 nrm =
+          (m.vertices[f[1]] - m.vertices[f[0]]).cross(m.vertices[f[2]] - m.vertices[f[0]]);
+      count += std::abs(nrm.z()) < 1e-9 * nrm.norm();
+    }
+    return count;
+  };
+  const std::size_t before = walls(box), after = walls(n->mesh);
+  ASSERT_EQ(before, 4u * 2 * 64);
+  EXPECT_GT(after, before);      // the diagonals in the band are split (1408 when a wall was
+  EXPECT_LE(after, 2 * before);  // split for its error in z as a flat face is), once each
+}
+
 }  // namespace
 }  // namespace nonplanar
