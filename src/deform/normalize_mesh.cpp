@@ -11,8 +11,9 @@
 namespace nonplanar {
 namespace {
 
-Vec3 mapped(const LayerField& f, const Vec3& p) {
-  return {p.x(), p.y(), f.zeta(f.T(p.x(), p.y(), p.z()))};
+// z of p's image (x and y stay).
+double mapped_z(const LayerField& f, const Vec3& p) {
+  return f.zeta(f.T(p.x(), p.y(), p.z()));
 }
 
 std::uint64_t edge_key(int a, int b) {
@@ -36,24 +37,43 @@ struct RoundEdges {
 };
 RoundEdges round_edges(const TriangleMesh& m, const std::vector<char>& final_face,
                        const std::vector<char>& settled) {
-  std::vector<std::pair<std::uint64_t, std::uint32_t>> half;
+  // (edge key, corner), 12 bytes: the sort's array is this stage's peak (Benchy's shell).
+  struct Half {
+    std::uint32_t lo, hi, corner;
+    bool operator<(const Half& o) const {
+      return lo != o.lo ? lo < o.lo : hi != o.hi ? hi < o.hi : corner < o.corner;
+    }
+    bool same_edge(const Half& o) const { return lo == o.lo && hi == o.hi; }
+  };
+  std::vector<Half> half;
   for (std::size_t c = 0; c < 3 * m.faces.size(); ++c)
-    if (!final_face[c / 3] && !settled[c]) half.emplace_back(corner_key(m, c), c);
+    if (!final_face[c / 3] && !settled[c]) {
+      const std::uint64_t k = corner_key(m, c);
+      half.push_back({static_cast<std::uint32_t>(k >> 32), static_cast<std::uint32_t>(k),
+                      static_cast<std::uint32_t>(c)});
+    }
   std::sort(half.begin(), half.end());
-  // Each key's first corner (the least, as sorted) names the edge; edges in that order.
-  std::vector<std::pair<std::uint32_t, std::size_t>> first;  // (first corner, start in half)
-  for (std::size_t h = 0; h < half.size(); ++h)
-    if (h == 0 || half[h].first != half[h - 1].first) first.emplace_back(half[h].second, h);
-  std::sort(first.begin(), first.end());
+  // Each key's first corner (the least, as sorted) leads its edge; corner_edge holds the key's
+  // rank among keys until the walk over the corners numbers the edges as their leaders come.
   RoundEdges r;
   r.corner_edge.assign(3 * m.faces.size(), -1);
-  r.edges.reserve(first.size());
-  for (const auto& [c, h0] : first) {
-    const int e = static_cast<int>(r.edges.size());
-    const auto& f = m.faces[c / 3];
-    r.edges.emplace_back(f[c % 3], f[(c + 1) % 3]);
-    for (std::size_t h = h0; h < half.size() && half[h].first == half[h0].first; ++h)
-      r.corner_edge[half[h].second] = e;
+  std::vector<std::uint32_t> leader;
+  for (std::size_t h = 0; h < half.size(); ++h) {
+    if (h == 0 || !half[h].same_edge(half[h - 1])) leader.push_back(half[h].corner);
+    r.corner_edge[half[h].corner] = static_cast<int>(leader.size() - 1);
+  }
+  half = {};
+  std::vector<int> number(leader.size(), -1);
+  r.edges.reserve(leader.size());
+  for (std::size_t c = 0; c < r.corner_edge.size(); ++c) {
+    const int g = r.corner_edge[c];
+    if (g < 0) continue;
+    if (leader[static_cast<std::size_t>(g)] == c) {
+      number[static_cast<std::size_t>(g)] = static_cast<int>(r.edges.size());
+      const auto& f = m.faces[c / 3];
+      r.edges.emplace_back(f[c % 3], f[(c + 1) % 3]);
+    }
+    r.corner_edge[c] = number[static_cast<std::size_t>(g)];
   }
   return r;
 }
@@ -67,22 +87,23 @@ bool strays(const LayerField& field, const Vec3& a, const Vec3& b, double za, do
   const int n = static_cast<int>(std::ceil((b - a).norm()));
   for (int i = 1; i < n; ++i) {
     const double s = static_cast<double>(i) / n;
-    if (std::abs(mapped(field, a + s * (b - a)).z() - (za + s * (zb - za))) > dz_max) return true;
+    if (std::abs(mapped_z(field, a + s * (b - a)) - (za + s * (zb - za))) > dz_max) return true;
   }
   return false;
 }
 
-// Per edge of `r`: the largest |n_z| of the unit normals of its faces as mapped (`image`), 1
+// Per edge of `r`: the largest |n_z| of the unit normals of its faces as mapped (z: `image`), 1
 // for a face of no area. A wall takes the map's error in z across its plane only that much:
 // the distance between the mapped mesh and the exact map is dz · |n_z|, and a steep wall's
 // section moves by it, not by dz (the sphere's normalised mesh had 8 times its faces).
-std::vector<float> flatness(const TriangleMesh& m, const std::vector<Vec3>& image,
+std::vector<float> flatness(const TriangleMesh& m, const std::vector<double>& image,
                             const std::vector<char>& final_face, const RoundEdges& r) {
   std::vector<float> flat(r.edges.size(), 0.0f);
   for (std::size_t fi = 0; fi < m.faces.size(); ++fi) {
     if (final_face[fi]) continue;
     const auto& f = m.faces[fi];
-    const Vec3 n = (image[f[1]] - image[f[0]]).cross(image[f[2]] - image[f[0]]);
+    auto at = [&](int v) { return Vec3(m.vertices[v].x(), m.vertices[v].y(), image[v]); };
+    const Vec3 n = (at(f[1]) - at(f[0])).cross(at(f[2]) - at(f[0]));
     const double len = n.norm();
     const float nz = len > 0 ? static_cast<float>(std::abs(n.z()) / len) : 1.0f;
     for (std::size_t k = 0; k < 3; ++k) {
@@ -133,11 +154,11 @@ Expected<NormalizedMesh> normalize_mesh(const TriangleMesh& mesh, const LayerFie
     return Error{Status::invalid_argument, "normalize tolerance: must be > 0"};
   NormalizedMesh out;
   TriangleMesh m = mesh;
-  std::vector<Vec3> image(m.vertices.size());
+  std::vector<double> image(m.vertices.size());  // each vertex's z as mapped
   // Field evaluations are the cost (a root-find in blend zones): in parallel, then the
   // bookkeeping in order, so the result does not depend on the thread count.
   core::parallel_for(std::size_t{0}, m.vertices.size(),
-                     [&](std::size_t v) { image[v] = mapped(field, m.vertices[v]); });
+                     [&](std::size_t v) { image[v] = mapped_z(field, m.vertices[v]); });
 
   // Edges already tested and kept whole keep their ends (vertices are only appended), so
   // the same test would keep them whole again: only edges made by a split are tested, and a
@@ -159,23 +180,23 @@ Expected<NormalizedMesh> normalize_mesh(const TriangleMesh& mesh, const LayerFie
     RoundEdges round_e = round_edges(m, final_face, settled);
     const std::vector<std::pair<int, int>>& edges = round_e.edges;
     const std::vector<float> flat = flatness(m, image, final_face, round_e);
-    std::vector<Vec3> im(edges.size());
+    std::vector<double> im(edges.size());  // each edge's midpoint's z as mapped
     std::vector<char> split_it(edges.size());
     core::parallel_for(std::size_t{0}, edges.size(), [&](std::size_t e) {
       const auto [a, b] = edges[e];
       const Vec3 pm = 0.5 * (m.vertices[a] + m.vertices[b]);
-      im[e] = mapped(field, pm);
+      im[e] = mapped_z(field, pm);
       // The map moves a point only in z: the exact midpoint lies dz above the chord, and
       // dz · |n_z| from the faces' planes.
-      const double dz = std::abs(im[e].z() - 0.5 * (image[a].z() + image[b].z()));
+      const double dz = std::abs(im[e] - 0.5 * (image[a] + image[b]));
       split_it[e] = dz * flat[e] > params.tolerance;
       // A midpoint on the chord does not prove a long edge maps straight: in a curved region
       // it is probed every millimetre too (split regardless, the sine roof's and FoilCutter's
       // vertical sides made 1644 and 6423 splits, all of them needless). A wall (n_z = 0) takes
       // no error from the map: not probed.
       const double len = (m.vertices[b] - m.vertices[a]).norm();
-      if (!split_it[e] && len > kLongEdge && im[e].z() != pm.z() && flat[e] > 1e-6f)
-        split_it[e] = strays(field, m.vertices[a], m.vertices[b], image[a].z(), image[b].z(),
+      if (!split_it[e] && len > kLongEdge && im[e] != pm.z() && flat[e] > 1e-6f)
+        split_it[e] = strays(field, m.vertices[a], m.vertices[b], image[a], image[b],
                              params.tolerance / flat[e]);
     });
     // Refused before the round is built when it would leave too many faces (a face with n
@@ -190,6 +211,9 @@ Expected<NormalizedMesh> normalize_mesh(const TriangleMesh& mesh, const LayerFie
     }
     if (params.max_faces > 0 && next_faces > params.max_faces) return too_many(params.max_faces);
     std::vector<int> mid(edges.size(), -1);  // each edge's midpoint vertex (-1: kept whole)
+    const auto split = static_cast<std::size_t>(std::count(split_it.begin(), split_it.end(), 1));
+    m.vertices.reserve(m.vertices.size() + split);
+    image.reserve(image.size() + split);
     for (std::size_t e = 0; e < edges.size(); ++e) {
       if (!split_it[e]) continue;
       const auto [a, b] = edges[e];
@@ -197,13 +221,11 @@ Expected<NormalizedMesh> normalize_mesh(const TriangleMesh& mesh, const LayerFie
       m.vertices.push_back(0.5 * (m.vertices[a] + m.vertices[b]));
       image.push_back(im[e]);
     }
-    std::size_t split = 0;
-    for (const int v : mid) split += v >= 0;
     std::vector<std::array<int, 3>> faces;
     std::vector<char> final_next, settled_next;
-    faces.reserve(m.faces.size());
-    final_next.reserve(m.faces.size());
-    settled_next.reserve(3 * m.faces.size());
+    faces.reserve(next_faces);
+    final_next.reserve(next_faces);
+    settled_next.reserve(3 * next_faces);
     // A child face's corner is settled when it runs along a parent's edge kept whole.
     auto add = [&](std::array<int, 3> f, bool s0, bool s1, bool s2) {
       faces.push_back(f);
@@ -249,7 +271,7 @@ Expected<NormalizedMesh> normalize_mesh(const TriangleMesh& mesh, const LayerFie
     ctx.progress("normalize", std::min(1.0, 0.1 * (round + 1)));
     if (split == 0) break;
   }
-  m.vertices = std::move(image);
+  for (std::size_t v = 0; v < m.vertices.size(); ++v) m.vertices[v].z() = image[v];
   out.mesh = std::move(m);
   return out;
 }
