@@ -96,6 +96,14 @@ std::vector<char> stands_above(const TriangleMesh& mesh, const std::vector<char>
   return above;
 }
 
+// t's raster with heights h (nx·ny), not a copy of t's own first.
+FacetedTop with_heights(const FacetedTop& t, std::vector<double> h) {
+  FacetedTop r;
+  r.origin = t.origin, r.cell = t.cell, r.nx = t.nx, r.ny = t.ny, r.h_lo = t.h_lo, r.h_hi = t.h_hi;
+  r.h = std::move(h);
+  return r;
+}
+
 // Chamfer distance (mm) from every node to the nearest marked one, two passes with steps of
 // one cell and a diagonal; +inf where nothing is marked. Each pass takes a row's three
 // neighbours in the row before it first (independent of each other), then runs along the row
@@ -136,9 +144,9 @@ std::vector<double> distance_to(const std::vector<char>& marked, const Raster& r
 // shell points printed in order of their times never leave a higher point beside a later,
 // lower one by more than k·d (min(k·d, a(d)) was not: next to the wall it rose as fast as the
 // cone, and the gate found the rib's shell 0.12 mm over a later piece 0.27 mm away).
-void set_slack(ShellRegion& out, const std::vector<double>& dist,
-               const std::vector<char>& patch_node, const std::vector<char>& grown,
-               const FacetedTop& top, double below, const LayerParams& p) {
+void set_slack(ShellRegion& out, std::vector<double> dist, const std::vector<char>& patch_node,
+               const std::vector<char>& grown, const FacetedTop& top, double below,
+               const LayerParams& p) {
   double farthest = 0;
   for (double d : dist)
     if (std::isfinite(d)) farthest = std::max(farthest, d);
@@ -163,20 +171,22 @@ void set_slack(ShellRegion& out, const std::vector<double>& dist,
   // k·(√2·cell/2 + 0.14) above the allowance there: m keeps that under h/2, with room for the
   // file's rounding. (h/4 was safe; the ornament's cap was then banded over 50.1 % of it.)
   const double m = 0.5 * p.layer_height - 0.005 - kSlope * (0.5 * M_SQRT2 * top.cell + 0.142);
-  out.slack = top;
-  for (std::size_t q = 0; q < dist.size(); ++q) {
-    if (!std::isfinite(dist[q])) {  // nothing stands above anywhere (not called then)
-      out.slack.h[q] = 1e9;
+  // In place of the distances: on the bunny's raster each is 16 MB, and two shells are
+  // planned side by side.
+  for (double& d : dist) {
+    if (!std::isfinite(d)) {  // nothing stands above anywhere (not called then)
+      d = 1e9;
       continue;
     }
-    const double f = dist[q] / top.cell;
+    const double f = d / top.cell;
     const std::size_t i = std::min(static_cast<std::size_t>(f), n - 2);
-    out.slack.h[q] = lip[i] + (lip[i + 1] - lip[i]) * (f - static_cast<double>(i)) + m;
+    d = lip[i] + (lip[i + 1] - lip[i]) * (f - static_cast<double>(i)) + m;
   }
+  out.slack = with_heights(top, std::move(dist));
   // g: the heights most patch nodes can be printed at (shell_levels.hpp), their intervals
   // [H − min(s, below), H + s].
   std::vector<double> u, lo, hi;
-  for (std::size_t q = 0; q < dist.size(); ++q)
+  for (std::size_t q = 0; q < out.slack.h.size(); ++q)
     if (patch_node[q] && !grown[q]) {
       u.push_back(top.h[q]);
       lo.push_back(top.h[q] - std::min(out.slack.h[q], below));
@@ -221,15 +231,18 @@ ShellRegion shell_region(const TriangleMesh& mesh, const std::vector<char>& in_p
   // left a hole 9 mm deep in the top. What it loses counts as standing above.
   {
     const double half = 0.5 * kNarrowest;
-    const std::vector<double> to_edge = distance_to(grown, r);
     std::vector<char> core(grown.size(), 0);
-    for (std::size_t q = 0; q < grown.size(); ++q) core[q] = !grown[q] && to_edge[q] > half;
+    {  // gone before to_core is made: two of these are 16 MB each on the bunny's raster
+      const std::vector<double> to_edge = distance_to(grown, r);
+      for (std::size_t q = 0; q < grown.size(); ++q) core[q] = !grown[q] && to_edge[q] > half;
+    }
     const std::vector<double> to_core = distance_to(core, r);
     for (std::size_t q = 0; q < grown.size(); ++q)
       if (!grown[q] && to_core[q] > half + 1e-9) grown[q] = 1, above[q] = kNarrow;
   }
-  out.mask = top;
-  for (std::size_t q = 0; q < grown.size(); ++q) out.mask.h[q] = grown[q] ? -1.0 : 1.0;
+  std::vector<double> mask(grown.size());
+  for (std::size_t q = 0; q < grown.size(); ++q) mask[q] = grown[q] ? -1.0 : 1.0;
+  out.mask = with_heights(top, std::move(mask));
 
   // The patch's nodes: most of them must be in R.
   std::vector<char> patch_node(above.size(), 0);
