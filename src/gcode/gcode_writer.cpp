@@ -493,12 +493,17 @@ Expected<std::string> make_gcode(const std::vector<LayerToolpaths>& layers, cons
   MacroVariables layer_vars = block_variables(c, facts);
   double max_z = 0;
   program::GcodeText w(g.relative_e);
-  // About 30 bytes a point, in room made once and backed by huge pages: the bunny's 67 MB
-  // grew by doubling, each new buffer faulting in 4 KiB at a time.
-  std::size_t points = 0;
-  for (const LayerToolpaths& L : layers)
+  // Room made once and backed by huge pages: the bunny's 67 MB grew by doubling, each new
+  // buffer faulting in 4 KiB at a time. More than it needs (a move's line is 30-45 bytes,
+  // a path's travel a few lines): pages never written are never resident, and a buffer that
+  // ran out was copied into one twice its size (the bunny's shells: 37 MB of text in 28.5,
+  // then 85.5 MB held at once).
+  std::size_t points = 0, paths = 0;
+  for (const LayerToolpaths& L : layers) {
+    paths += L.paths.size();
     for (const ExtrusionPath& p : L.paths) points += p.points.size();
-  w.out.reserve((std::size_t(1) << 20) + 32 * points);
+  }
+  w.out.reserve((std::size_t(1) << 20) + 48 * points + 160 * paths);
   advise_huge_pages(w.out.data(), w.out.capacity());
   const gcode::ObjectLabels labels = gcode::object_labels(c);
   write_start(w, c, *blocks, header, labels.define(layers));
