@@ -29,9 +29,10 @@ namespace nonplanar {
 namespace {
 
 using Kind = GcodeLine::Kind;
-constexpr std::size_t kMappedAtOnce = 64;  ///< layers mapped side by side, then written
 using program::GcodeText;
 using program::LayerWork;
+
+constexpr std::size_t kMappedAtOnce = 64;  ///< layers mapped side by side, then written
 
 // What carries over from one layer's writing to the next.
 struct Writing {

@@ -493,11 +493,10 @@ Expected<std::string> make_gcode(const std::vector<LayerToolpaths>& layers, cons
   MacroVariables layer_vars = block_variables(c, facts);
   double max_z = 0;
   program::GcodeText w(g.relative_e);
-  // Room made once and backed by huge pages: the bunny's 67 MB grew by doubling, each new
-  // buffer faulting in 4 KiB at a time. More than it needs (a move's line is 30-45 bytes,
-  // a path's travel a few lines): pages never written are never resident, and a buffer that
-  // ran out was copied into one twice its size (the bunny's shells: 37 MB of text in 28.5,
-  // then 85.5 MB held at once).
+  // Room made once and backed by huge pages (a text grown by doubling faulted each new buffer
+  // in 4 KiB at a time), and more than it needs: 39-43.5 bytes a point were measured (a move's
+  // line, a path's travel a few lines), and pages never written are never resident. At 32 a
+  // point the bunny's shells (37 MB of text) ran out at 28.5 MB and were copied into 57 MB.
   std::size_t points = 0, paths = 0;
   for (const LayerToolpaths& L : layers) {
     paths += L.paths.size();
