@@ -69,9 +69,10 @@ int run(const LayersOptions& o) {
   auto analysis = analyze(loaded->mesh, job->analysis, ctx);
   if (!analysis) return finish_progress(), report_error(analysis.error());
   std::vector<int> ids;
-  auto fits = fit_patches(loaded->mesh, *analysis, job->fit, {}, &ids, ctx);
+  StackCache cache;
+  auto fits = fit_for_plan(loaded->mesh, *analysis, job->fit, lp, cache, &ids, ctx);
   if (!fits) return finish_progress(), report_error(fits.error());
-  auto plan = plan_layers(loaded->mesh, *analysis, *fits, ids, lp, ctx);
+  auto plan = plan_layers(loaded->mesh, *analysis, *fits, ids, lp, cache, ctx);
   if (!plan) return finish_progress(), report_error(plan.error());
   std::size_t split = 0;
   if (!o.export_normalized.empty()) {

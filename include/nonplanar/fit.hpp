@@ -60,6 +60,11 @@ struct SurfaceFit {
   double seconds = 0;
 };
 
+/// The rectangle fit_height_field fits a surface over: [xy_min, xy_max] grown on each side by
+/// `margin` of its size, at least 0.5 mm. Output: a HeightField with that origin and extent
+/// (mm) and no control points yet (plan_layers' stack checks that need no surface use it).
+HeightField fit_rectangle(const Vec2& xy_min, const Vec2& xy_max, double margin);
+
 /// Fit z = S(x, y) to scattered samples (x, y, z) over the rectangle [xy_min, xy_max] (grown
 /// by the margin). `min_span` (mm) stops refinement below that knot spacing, so a faceted
 /// mesh is not fitted facet by facet. Errors: invalid_argument (naming the parameter, or

@@ -107,6 +107,19 @@ class StackCache {
   std::unique_ptr<Impl> impl_;
 };
 
+/// The surfaces plan_layers needs, fitted for the patches that need non-planar layers, in
+/// patch order (*patch_of_fit), except where the facets alone refuse the patch's stack (its
+/// relief, slope, the material under or above it: build_stack's checks before the surface):
+/// such a patch gets its rectangle unfitted (fit_rectangle: no control points) and its refusal
+/// goes into `cache`, where plan_layers finds it (it would refuse it again without), so the
+/// plan is the one all fits would give. Fitting the CurviSlicer car's roof,
+/// whose stack the part's hollow refuses, took a third of its slice.
+/// Errors: as fit_patches (fit params), cancelled.
+Expected<std::vector<SurfaceFit>> fit_for_plan(const TriangleMesh& mesh, const Analysis& analysis,
+                                               const FitParams& fit, const LayerParams& params,
+                                               StackCache& cache, std::vector<int>* patch_of_fit,
+                                               const Context& ctx);
+
 /// plan_layers, reusing and filling `cache`.
 Expected<LayerPlan> plan_layers(const TriangleMesh& mesh, const Analysis& analysis,
                                 const std::vector<SurfaceFit>& fits,

@@ -168,6 +168,45 @@ Expected<LayerPlan> plan_layers(const TriangleMesh& mesh, const Analysis& analys
   return plan_layers(mesh, analysis, fits, patch_of_fit, params, cache, ctx);
 }
 
+Expected<std::vector<SurfaceFit>> fit_for_plan(const TriangleMesh& mesh, const Analysis& analysis,
+                                               const FitParams& fit, const LayerParams& params,
+                                               StackCache& cache, std::vector<int>* patch_of_fit,
+                                               const Context& ctx) {
+  if (auto e = check(params)) return *e;
+  std::vector<int> ids;
+  for (std::size_t i = 0; i < analysis.patches.size(); ++i)
+    if (analysis.patches[i].needs_nonplanar()) ids.push_back(static_cast<int>(i));
+  // Each patch's checks on its own, side by side (as plan_layers builds stacks).
+  const PlanarLayers planar{params.first_layer_height, params.layer_height};
+  const ColumnCaster columns(mesh);
+  std::vector<layers::StackResult> early(ids.size());
+  std::vector<SurfaceFit> out(ids.size());
+  core::parallel_for(std::size_t{0}, ids.size(), [&](std::size_t k) {
+    if (ctx.cancelled()) return;
+    const Patch& patch = analysis.patches[static_cast<std::size_t>(ids[k])];
+    out[k].surface = fit_rectangle(patch.xy_min, patch.xy_max, fit.margin);
+    early[k] =
+        layers::build_stack(mesh, patch, ids[k], out[k].surface, columns, params, planar, 1.0, ctx);
+  });
+  if (ctx.cancelled()) return Error{Status::cancelled, "cancelled"};
+  std::vector<int> refused;
+  for (std::size_t k = 0; k < ids.size(); ++k)
+    if (!early[k].needs_fit) refused.push_back(ids[k]);
+  std::vector<int> fitted_ids;
+  auto fits = fit_patches(mesh, analysis, fit, refused, &fitted_ids, ctx);
+  if (!fits) return fits.error();
+  // All the patches in order, the rectangle unfitted for each refused one.
+  for (std::size_t k = 0, f = 0; k < ids.size(); ++k) {
+    if (early[k].needs_fit) {
+      out[k] = std::move((*fits)[f++]);
+    } else {
+      cache.impl().built.emplace(ids[k], std::move(early[k]));
+    }
+  }
+  *patch_of_fit = std::move(ids);
+  return out;
+}
+
 Expected<LayerPlan> plan_layers(const TriangleMesh& mesh, const Analysis& analysis,
                                 const std::vector<SurfaceFit>& fits,
                                 const std::vector<int>& patch_of_fit, const LayerParams& params,
@@ -197,8 +236,13 @@ Expected<LayerPlan> plan_layers(const TriangleMesh& mesh, const Analysis& analys
                                    fits[i].surface, columns, params, planar, 1.0, ctx);
   });
   if (ctx.cancelled()) return Error{Status::cancelled, "cancelled"};
-  for (std::size_t k = 0; k < missing.size(); ++k)
+  for (std::size_t k = 0; k < missing.size(); ++k) {
+    if (fresh[k].needs_fit)
+      return Error{Status::invalid_argument, "plan_layers: patch " +
+                                                 std::to_string(patch_of_fit[missing[k]]) +
+                                                 " needs its fitted surface"};
     built.emplace(patch_of_fit[missing[k]], std::move(fresh[k]));
+  }
   ctx.progress("layers", 0.8);
   LayerPlan plan;
   std::vector<Band> bands;

@@ -51,6 +51,7 @@ void build_stack_grid(StackGrid& g, const HeightField& hf, double step,
       g.xy.emplace_back(x, y);
       g.area.push_back(dx * dy);
       g.on_patch.push_back(on);
+      if (s.points.empty()) continue;  // not fitted yet: the points only
       const Vec2 uv = hf.uv(x, y);
       const int su = nurbs::find_span(s.n_u, s.p, uv.x(), s.U);
       const int sv = nurbs::find_span(s.n_v, s.q, uv.y(), s.V);

@@ -51,7 +51,9 @@ struct CostTerms {
 double printability_cost(const StackGrid& grid, const Eigen::MatrixXd& Z, const CostTerms& c,
                          Eigen::MatrixXd* grad);
 
-void build_stack_grid(StackGrid& g, const HeightField& s, double step,
+/// The samples at `step` (mm) over hf's rectangle, on_patch where the raster's mask is set,
+/// with hf's basis; without it when hf has no control points (hf's rectangle only).
+void build_stack_grid(StackGrid& g, const HeightField& hf, double step,
                       const std::vector<char>& raster_mask, const Vec2& raster_origin,
                       double raster_cell, int raster_nx, int raster_ny);
 

@@ -180,8 +180,11 @@ StackResult build_stack(const TriangleMesh& mesh, const Patch& patch, int patch_
       span = std::min(span, (top.surface.V[i + 1] - top.surface.V[i]) * top.extent.y());
   const double coarse_step =
       std::max(step, std::min(std::max(top.extent.x(), top.extent.y()) / 40.0, span / 2.0));
-  build_stack_grid(coarse, top, coarse_step, raster.mask, raster.origin, raster.cell, raster.nx,
-                   raster.ny);
+  // Without a fitted surface, only the checks the facets decide (build_stack's header).
+  const bool fitted = !top.surface.points.empty();
+  if (fitted)
+    build_stack_grid(coarse, top, coarse_step, raster.mask, raster.origin, raster.cell, raster.nx,
+                     raster.ny);
 
   // Heights of the top over the whole rectangle (the stack must be valid where it blends).
   // It follows the facets (the band's raster, built last, carries them past the rim).
@@ -194,10 +197,13 @@ StackResult build_stack(const TriangleMesh& mesh, const Patch& patch, int patch_
     H.resize(n), dH.resize(n);
     for (int k = 0; k < n; ++k) {
       const bool ok = std::isfinite(fs.h[k]) && fs.slope[k].allFinite();
+      if (!ok && !fitted && grid.on_patch[k]) return out.needs_fit = true, out;
+      if (!ok && !fitted) continue;  // off the patch: read after the checks below only
       H[k] = ok ? fs.h[k] : top.height(grid.xy[k].x(), grid.xy[k].y());
       dH[k] = ok ? fs.slope[k] : top.gradient(grid.xy[k].x(), grid.xy[k].y());
     }
   }
+  if (!fitted && !p.faceted_top) return out.needs_fit = true, out;
   double zmin = 1e300, zmax = -1e300, on_sum = 0, top_slope = 0;
   int on_count = 0;
   for (int k = 0; k < n; ++k) {
@@ -319,6 +325,7 @@ StackResult build_stack(const TriangleMesh& mesh, const Patch& patch, int patch_
       return out;
     }
   }
+  if (!fitted) return out.needs_fit = true, out;
 
   // How far the curved layers sit from the planar ones decides how gently they blend. The
   // blend's raster and the band's faceted top depend only on that, so they are built while

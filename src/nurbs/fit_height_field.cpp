@@ -66,6 +66,15 @@ std::vector<char> spans_to_split(const std::vector<int>& span_of, int n,
 
 }  // namespace
 
+HeightField fit_rectangle(const Vec2& xy_min, const Vec2& xy_max, double margin) {
+  HeightField hf;
+  const Vec2 size = xy_max - xy_min;
+  const Vec2 grow(std::max(0.5, margin * size.x()), std::max(0.5, margin * size.y()));
+  hf.origin = xy_min - grow;
+  hf.extent = size + 2 * grow;
+  return hf;
+}
+
 Expected<SurfaceFit> fit_height_field(const std::vector<Vec3>& samples, const Vec2& xy_min,
                                       const Vec2& xy_max, double min_span, const FitParams& params,
                                       const Context& ctx) {
@@ -80,10 +89,7 @@ Expected<SurfaceFit> fit_height_field(const std::vector<Vec3>& samples, const Ve
 
   SurfaceFit out;
   HeightField& hf = out.surface;
-  const Vec2 size = xy_max - xy_min;
-  const Vec2 grow(std::max(0.5, params.margin * size.x()), std::max(0.5, params.margin * size.y()));
-  hf.origin = xy_min - grow;
-  hf.extent = size + 2 * grow;
+  hf = fit_rectangle(xy_min, xy_max, params.margin);
   std::vector<Vec3> uvz(samples.size());
   for (std::size_t k = 0; k < samples.size(); ++k) {
     const Vec2 t = hf.uv(samples[k].x(), samples[k].y());

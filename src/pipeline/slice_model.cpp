@@ -490,7 +490,7 @@ Expected<SliceResult> slice_rounds(const TriangleMesh& mesh, const SliceJob& job
     auto a = analyze(mesh, job.analysis, ctx);
     if (!a) return a.error();
     pre.analysis = std::move(*a);
-    auto fits = fit_patches(mesh, pre.analysis, job.fit, {}, &pre.ids, ctx);
+    auto fits = fit_for_plan(mesh, pre.analysis, job.fit, job.layers, pre.stacks, &pre.ids, ctx);
     if (!fits) return fits.error();
     pre.fits = std::move(*fits);
   }

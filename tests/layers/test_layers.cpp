@@ -158,6 +158,62 @@ TEST(Layers, StackCacheGivesTheSamePlanWithFewerPatches) {
   EXPECT_FALSE(both->field->planar_at(out.x(), out.y()));
 }
 
+// A patch whose stack the facets refuse gets no fit (the rib: its relief needs a plane under
+// the bed; the hollow roof: no material under its top), and the plan is the one every fit
+// gives: the same fallbacks, word for word, and the same stacks.
+void expect_plan_without_refused_fits(const TriangleMesh& mesh, int refused, int stacked) {
+  const Planned all = plan_for(mesh);
+  StackCache cache;
+  std::vector<int> ids;
+  auto fits = fit_for_plan(all.mesh, all.analysis, {}, {}, cache, &ids, {});
+  ASSERT_TRUE(fits) << fits.error().message;
+  EXPECT_EQ(ids, all.ids);
+  ASSERT_EQ(fits->size(), ids.size());
+  int unfitted = 0;
+  for (std::size_t i = 0; i < ids.size(); ++i) {
+    const bool empty = (*fits)[i].surface.surface.points.empty();
+    unfitted += empty;
+    if (!empty) {  // fitted as fit_patch fits it
+      EXPECT_EQ((*fits)[i].rms_error, all.fits[i].rms_error);
+    }
+  }
+  EXPECT_EQ(unfitted, refused);
+  auto plan = plan_layers(all.mesh, all.analysis, *fits, ids, {}, cache, {});
+  ASSERT_TRUE(plan) << plan.error().message;
+  ASSERT_EQ(plan->stacks.size(), static_cast<std::size_t>(stacked));
+  ASSERT_EQ(plan->stacks.size(), all.plan.stacks.size());
+  for (std::size_t i = 0; i < plan->stacks.size(); ++i) {
+    EXPECT_EQ(plan->stacks[i].patch, all.plan.stacks[i].patch);
+    EXPECT_EQ(plan->stacks[i].c, all.plan.stacks[i].c);
+    EXPECT_EQ(plan->stacks[i].thickness_min, all.plan.stacks[i].thickness_min);
+  }
+  ASSERT_EQ(plan->fallbacks.size(), all.plan.fallbacks.size());
+  for (std::size_t i = 0; i < plan->fallbacks.size(); ++i) {
+    EXPECT_EQ(plan->fallbacks[i].patch, all.plan.fallbacks[i].patch);
+    EXPECT_EQ(plan->fallbacks[i].reason, all.plan.fallbacks[i].reason);
+  }
+  // The facets refuse it again without the cache; a patch they do not refuse needs its fit:
+  // an empty surface there is an error, not a stack.
+  auto bare = plan_layers(all.mesh, all.analysis, *fits, ids, {}, {});
+  ASSERT_TRUE(bare);
+  EXPECT_EQ(bare->fallbacks.size(), all.plan.fallbacks.size());
+  if (stacked == 0) return;
+  std::vector<SurfaceFit> none(fits->size());
+  for (std::size_t i = 0; i < none.size(); ++i) {
+    const Patch& q = all.analysis.patches[static_cast<std::size_t>(ids[i])];
+    none[i].surface = fit_rectangle(q.xy_min, q.xy_max, FitParams{}.margin);
+  }
+  auto unfit = plan_layers(all.mesh, all.analysis, none, ids, {}, {});
+  ASSERT_FALSE(unfit);
+  EXPECT_NE(unfit.error().message.find("needs its fitted surface"), std::string::npos);
+}
+
+TEST(Layers, PatchesTheFacetsRefuseAreNotFitted) {
+  expect_plan_without_refused_fits(test::rib_and_domed_tower(), 1, 1);
+  expect_plan_without_refused_fits(test::hollow_roof(1.5), 1, 0);
+  expect_plan_without_refused_fits(towers(), 0, 2);
+}
+
 // FoilCutter's fit swings off its patch, where its layers broke the limits with penalties no
 // move of the free layers could lift (a cost of 2.6e9 at the start): the optimiser ran its
 // 100 iterations, bent the layers over the patch, and its result was thrown away. The limits
