@@ -78,13 +78,8 @@ struct ForeignGcode {
   std::vector<LayerToolpaths> layers;  ///< one per ;LAYER_CHANGE of the print
   /// The whole program: start, print and end as one text.
   std::string text() const { return start + print + end; }
-  /// The same, taking the blocks' text (no copy of the print kept).
-  std::string take_text() {
-    std::string t = std::move(start);
-    t.append(print).append(end);
-    print = std::string(), end = std::string();
-    return t;
-  }
+  /// The same after `head`, taking the blocks' text (no copy of the print kept).
+  std::string take_text(std::string_view head = {});
   bool relative_e_at_print = false, relative_e_at_end = false;
   double e_at_print = 0;     ///< the file's E when the print starts (absolute E), mm
   std::string fan_at_print;  ///< the start G-code's last M106/M107 line (empty: none)

@@ -15,6 +15,7 @@
 #include <Eigen/Eigenvalues>
 
 #include "core/column_caster.hpp"
+#include "core/huge_pages.hpp"
 #include "nonplanar/check.hpp"
 
 namespace nonplanar {
@@ -206,7 +207,7 @@ class Deposit {
       : lo_((lo / (kSize[0] * cell)).array().floor() * (kSize[0] * cell)), cell_(cell) {
     nx_ = static_cast<int>((hi.x() - lo_.x()) / cell) + 2;
     ny_ = static_cast<int>((hi.y() - lo_.y()) / cell) + 2;
-    cells_.assign(static_cast<std::size_t>(nx_) * ny_, Cell{});
+    assign_huge(cells_, static_cast<std::size_t>(nx_) * ny_, Cell{});
     for (int l = 0; l < kLevels; ++l) {
       lx_[l] = nx_ / kSize[l] + 1, ly_[l] = ny_ / kSize[l] + 1;
       level_[l].assign(static_cast<std::size_t>(lx_[l]) * ly_[l], Cell{});
@@ -282,11 +283,14 @@ class Deposit {
         const double dx = std::max({bx0 - q.p.x(), 0.0, q.p.x() - (bx0 + n * cell_)});
         const double dy = std::max({by0 - q.p.y(), 0.0, q.p.y() - (by0 + n * cell_)});
         if (dx * dx + dy * dy > R * R) continue;
+        // The head's allowance is never negative: a block no higher than p + depth is passed
+        // before its (costlier) allowance is worked out.
+        const double z = earlier_z(level_[l][static_cast<std::size_t>(bi) * ly_[l] + bj], q.layer);
+        if (z <= q.p.z() + q.depth) continue;
         const double allow = q.head.allowance_lower_bound(
             Vec2(bx0 - q.p.x(), by0 - q.p.y()),
             Vec2(bx0 + n * cell_ - q.p.x(), by0 + n * cell_ - q.p.y()));
-        const Cell& c = level_[l][static_cast<std::size_t>(bi) * ly_[l] + bj];
-        if (earlier_z(c, q.layer) <= q.p.z() + q.depth + allow) continue;
+        if (z <= q.p.z() + q.depth + allow) continue;
         // The finer level's blocks (or the cells) inside this one, within the radius.
         const bool last = l + 1 == kLevels;
         const int sub = last ? 1 : kSize[l + 1];  // cells per child block

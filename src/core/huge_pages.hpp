@@ -7,6 +7,9 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <initializer_list>
+#include <string>
+#include <string_view>
 #include <vector>
 
 namespace nonplanar {
@@ -36,6 +39,34 @@ void assign_huge(std::vector<T, A>& v, std::size_t n, const T& x) {
   std::vector<T, A>().swap(v);
   reserve_huge(v, n);
   v.assign(n, x);
+}
+
+/// s.reserve(n), the new room huge-page-advised: for a text written at once, as large as n.
+inline void reserve_text(std::string& s, std::size_t n) {
+  if (s.capacity() >= n) return;
+  s.reserve(n);
+  advise_huge_pages(s.data(), n);
+}
+
+/// The texts one after another in one string of their total size, huge-page-advised (a
+/// G-code file put together by appends was copied into each larger buffer, its pages faulted
+/// in each time).
+inline std::string joined_huge(std::initializer_list<std::string_view> parts) {
+  std::size_t n = 0;
+  for (std::string_view p : parts) n += p.size();
+  std::string out;
+  out.reserve(n);
+  advise_huge_pages(out.data(), n);
+  for (std::string_view p : parts) out.append(p);
+  return out;
+}
+
+/// n copies of x in a huge-page-advised buffer (a raster, a grid: written all over at once).
+template <class T>
+std::vector<T> huge_vector(std::size_t n, const T& x) {
+  std::vector<T> v;
+  assign_huge(v, n, x);
+  return v;
 }
 
 }  // namespace nonplanar

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include "core/huge_pages.hpp"
+
 namespace nonplanar::layers {
 namespace {
 
@@ -112,7 +114,7 @@ FacetedTop with_heights(const FacetedTop& t, std::vector<double> h) {
 std::vector<double> distance_to(const std::vector<char>& marked, const Raster& r) {
   const FacetedTop& t = r.t;
   const int nx = t.nx, ny = t.ny;
-  std::vector<double> d(marked.size(), std::numeric_limits<double>::infinity());
+  std::vector<double> d = huge_vector(marked.size(), std::numeric_limits<double>::infinity());
   for (std::size_t q = 0; q < marked.size(); ++q)
     if (marked[q]) d[q] = 0;
   const double s = t.cell, sd = t.cell * M_SQRT2;
@@ -240,7 +242,7 @@ ShellRegion shell_region(const TriangleMesh& mesh, const std::vector<char>& in_p
     for (std::size_t q = 0; q < grown.size(); ++q)
       if (!grown[q] && to_core[q] > half + 1e-9) grown[q] = 1, above[q] = kNarrow;
   }
-  std::vector<double> mask(grown.size());
+  std::vector<double> mask = huge_vector(grown.size(), 0.0);
   for (std::size_t q = 0; q < grown.size(); ++q) mask[q] = grown[q] ? -1.0 : 1.0;
   out.mask = with_heights(top, std::move(mask));
 

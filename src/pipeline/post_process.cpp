@@ -7,6 +7,7 @@
 #include <map>
 #include <optional>
 
+#include "core/huge_pages.hpp"
 #include "core/polygon_ops.hpp"
 #include "engine/shell_engine.hpp"
 #include "layers/shell_plan.hpp"
@@ -464,20 +465,6 @@ Expected<PostProcessed> post_process_gcode(std::string_view gcode, const PrintPl
   SliceJob job = make_job(*cfg, plan.max_angle_deg);
   auto field = parse_layer_field_json(plan.field, moved);
   if (!field) return field.error();
-  SliceResult r;
-  std::string body;
-  if (checked->split) {
-    auto joined = map_shell_gcode(*checked->split, moved, job, ctx);
-    if (!joined) return joined.error();
-    r.layers = std::move(joined->layers);
-    body = std::move(joined->gcode);
-  } else {
-    auto mapped = map_foreign_gcode(gcode, **field, job.map_back, ctx, checked->options);
-    if (!mapped) return mapped.error();
-    r.layers = std::move(mapped->layers);
-    body = mapped->take_text();
-  }
-  r.nonplanar = true;
   char buf[240];
   std::snprintf(buf, sizeof buf, "%s %s from %s (plan of %s; the part moved by %.3f, %.3f mm)\n",
                 kPostProcessedMark.data(), "0.1.0", plan.object.c_str(), plan.model.c_str(),
@@ -488,7 +475,19 @@ Expected<PostProcessed> post_process_gcode(std::string_view gcode, const PrintPl
                 centre.x(), centre.y());
   head += buf;
   for (const std::string& h : plan.header) head += "; " + h + "\n";
-  r.gcode = head + body;
+  SliceResult r;
+  if (checked->split) {
+    auto joined = map_shell_gcode(*checked->split, moved, job, ctx);
+    if (!joined) return joined.error();
+    r.layers = std::move(joined->layers);
+    r.gcode = joined_huge({head, joined->gcode});
+  } else {
+    auto mapped = map_foreign_gcode(gcode, **field, job.map_back, ctx, checked->options);
+    if (!mapped) return mapped.error();
+    r.layers = std::move(mapped->layers);
+    r.gcode = mapped->take_text(head);
+  }
+  r.nonplanar = true;
   std::string breach;
   auto ok = gate(
       r, job, checked->split ? nullptr : dynamic_cast<const layers::BandedField*>(field->get()),

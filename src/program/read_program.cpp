@@ -119,7 +119,8 @@ void Reader::run(std::string_view text) {
   // the first such move past the room doubled the vector, 82 MB more at the bunny's peak
   // through PrusaSlicer. Room never written is never resident.
   const bool keep = !sink_ && !line_sink_;
-  if (keep) p_.lines.reserve(n.lines), p_.moves.reserve(n.g_lines + n.g_lines / 2 + 1024);
+  if (keep)
+    reserve_huge(p_.lines, n.lines), reserve_huge(p_.moves, n.g_lines + n.g_lines / 2 + 1024);
   for_each_line(text, [&](std::size_t i, std::string_view l) {
     GcodeLine item;
     item.raw = l;
