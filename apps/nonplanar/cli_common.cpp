@@ -113,6 +113,12 @@ void tune_allocator(bool memory_limited) {
 
 }  // namespace
 
+void forget_launcher_tunables() {
+  if (!std::getenv("NONPLANAR_SET_TUNABLES")) return;
+  ::unsetenv("GLIBC_TUNABLES");
+  ::unsetenv("NONPLANAR_SET_TUNABLES");
+}
+
 bool install_limits(const Limits& l) {
   tune_allocator(l.max_memory_mb > 0);
   g_max_memory = l.max_memory_mb, g_max_time = l.max_time_s;

@@ -137,4 +137,8 @@ void finish_progress();
 /// none or the block does not read (a notice says why, unless quiet).
 PrintConfig file_config(const std::string& file, std::string_view gcode, bool quiet);
 
+/// The GLIBC_TUNABLES build/nonplanar set for this process (apps/launcher), out of the
+/// environment the slicers it runs inherit: glibc has read it already.
+void forget_launcher_tunables();
+
 }  // namespace nonplanar::cli

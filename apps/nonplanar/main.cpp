@@ -10,6 +10,7 @@
 
 int main(int argc, char** argv) {
   using namespace nonplanar::cli;
+  forget_launcher_tunables();
   CLI::App app{
       "nonplanar - slice FDM parts with curved (non-planar) top layers.\n"
       "Run 'nonplanar COMMAND --help' for the options of a command."};

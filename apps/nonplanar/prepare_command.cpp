@@ -65,11 +65,15 @@ std::string num(double v) {
   return buf;
 }
 
-// The absolute path of this executable, for the line to paste into the slicer.
+// The absolute path of the command, for the line to paste into the slicer: the launcher
+// beside this program (apps/launcher), which is what a user runs.
 std::string self_path() {
   std::error_code ec;
   const fs::path p = fs::read_symlink("/proc/self/exe", ec);
-  return ec ? std::string("nonplanar") : p.string();
+  if (ec) return "nonplanar";
+  const fs::path launcher = p.parent_path() / "nonplanar";
+  return p.filename() == "nonplanar-core" && fs::exists(launcher, ec) ? launcher.string()
+                                                                      : p.string();
 }
 
 std::string quoted(const std::string& s) {
