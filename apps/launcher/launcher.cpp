@@ -3,10 +3,10 @@
 // glibc.malloc.hugetlb=1). A page fault costs about 11 µs on the virtual machines measured
 // here (64 MB touched page by page: 180 ms; as huge pages: 36-77 ms), and a slice writes
 // tens of megabytes of fresh rasters, meshes and text: the sine roof sliced in 0.83 of the
-// time, Benchy in 0.84, FoilCutter in 0.90. glibc reads the tunable only as a process starts,
-// hence this launcher: static, so it costs a millisecond where the program's own start (34
-// shared libraries) costs 17. A GLIBC_TUNABLES the user set is left as it is; nonplanar-core
-// takes ours out of its environment at once, so the slicers it runs get the user's.
+// time, the wing and FoilCutter in 0.86, Benchy in 0.88. glibc reads the tunable only as a
+// process starts, hence this launcher: static, so it costs 1-2 ms where the program's own
+// start (34 shared libraries) costs 17. A GLIBC_TUNABLES the user set is left as it is;
+// nonplanar-core takes ours out of its environment at once, so the slicers it runs get the user's.
 #include <unistd.h>
 
 #include <cerrno>
@@ -14,8 +14,7 @@
 #include <cstdlib>
 #include <cstring>
 
-int main(int argc, char** argv) {
-  (void)argc;
+int main(int, char** argv) {
   char path[4096];
   constexpr char kCore[] = "nonplanar-core";
   const ssize_t n = readlink("/proc/self/exe", path, sizeof path - sizeof kCore);

@@ -55,8 +55,7 @@ inline std::string joined_huge(std::initializer_list<std::string_view> parts) {
   std::size_t n = 0;
   for (std::string_view p : parts) n += p.size();
   std::string out;
-  out.reserve(n);
-  advise_huge_pages(out.data(), n);
+  reserve_text(out, n);
   for (std::string_view p : parts) out.append(p);
   return out;
 }

@@ -161,6 +161,9 @@ StackResult build_stack(const TriangleMesh& mesh, const Patch& patch, int patch_
                         const HeightField& top, const ColumnCaster& columns, const LayerParams& p,
                         const PlanarLayers& planar, double initial_power, const Context& ctx) {
   StackResult out;
+  // Without a fitted surface, only the checks the facets decide (build_stack's header).
+  const bool fitted = !top.surface.points.empty();
+  if (!fitted && !p.faceted_top) return out.needs_fit = true, out;
   LayerStack& st = out.stack;
   st.patch = patch_id;
   st.xy_min = patch.xy_min;
@@ -180,8 +183,6 @@ StackResult build_stack(const TriangleMesh& mesh, const Patch& patch, int patch_
       span = std::min(span, (top.surface.V[i + 1] - top.surface.V[i]) * top.extent.y());
   const double coarse_step =
       std::max(step, std::min(std::max(top.extent.x(), top.extent.y()) / 40.0, span / 2.0));
-  // Without a fitted surface, only the checks the facets decide (build_stack's header).
-  const bool fitted = !top.surface.points.empty();
   if (fitted)
     build_stack_grid(coarse, top, coarse_step, raster.mask, raster.origin, raster.cell, raster.nx,
                      raster.ny);
@@ -203,7 +204,6 @@ StackResult build_stack(const TriangleMesh& mesh, const Patch& patch, int patch_
       dH[k] = ok ? fs.slope[k] : top.gradient(grid.xy[k].x(), grid.xy[k].y());
     }
   }
-  if (!fitted && !p.faceted_top) return out.needs_fit = true, out;
   double zmin = 1e300, zmax = -1e300, on_sum = 0, top_slope = 0;
   int on_count = 0;
   for (int k = 0; k < n; ++k) {

@@ -18,8 +18,8 @@ std::string tunables_the_engine_sees() {
   const fs::path dir = test::temp_dir("launcher_env");
   EXPECT_TRUE(write_stl(dir / "b.stl", test::box({0, 0, 0}, {10, 10, 1})));
   const fs::path seen = dir / "seen", engine = dir / "engine.sh";
-  test::write_bytes(engine, "#!/bin/sh\necho \"[${GLIBC_TUNABLES-unset}]\" > " + seen.string() +
-                                "\nexit 3\n");
+  test::write_bytes(
+      engine, "#!/bin/sh\necho \"[${GLIBC_TUNABLES-unset}]\" > " + seen.string() + "\nexit 3\n");
   fs::permissions(engine, fs::perms::owner_all);
   const test::CliResult r =
       test::run_cli("slice -q " + (dir / "b.stl").string() + " -o " + (dir / "b.gcode").string() +
