@@ -247,6 +247,10 @@ struct PrintMove {
 std::vector<GcodeProblem> for_each_gcode_move(std::string_view text,
                                               const std::function<void(const GcodeMove&)>& f);
 
+/// A move as check reads it: the GcodeMove's ends, filament, type (viewing the same text),
+/// layer, width and line.
+PrintMove print_move(const GcodeMove& g);
+
 /// The moves of a file as check reads them, one at a time to f, among those `keep` accepts
 /// (null: all). Problems are not looked at (for a file this program wrote or mapped itself).
 void for_each_print_move(std::string_view text, const std::function<bool(const GcodeMove&)>& keep,

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "core/huge_pages.hpp"
 #include "core/parallel.hpp"
 #include "nonplanar/check.hpp"
 #include "nonplanar/gcode.hpp"
@@ -47,6 +48,9 @@ Expected<void> write_program(SliceResult& r, const SliceJob& job, const Context&
 
 namespace {
 
+// Most G lines of a program whose gate holds its moves in memory: 26 MB of PrintMove at most.
+constexpr std::size_t kHeldMoves = 250000;
+
 // Whether a path is another slicer's support on a plane: printed as that slicer made it, on
 // layers of its own a contact distance apart (PrusaSlicer's beside a shell's core: 0.02 mm).
 bool flat_support(const ExtrusionPath& p) {
@@ -75,12 +79,15 @@ bool heights(const SliceResult& r, const LayerParams& L, const GateParams& g,
 // Slope within max_angle (with g's slack) on the extrusions of the program about to be
 // written, read back from r.gcode: the coordinates the printer gets, not the paths they were
 // rounded from. Only the print's own lines count: not the skirt, and not custom blocks (the
-// user's start G-code, before any ;TYPE: or under "Custom"). Fills r.steepest_deg.
-bool slopes(SliceResult& r, const LayerParams& L, const GateParams& g, const Violation& violation) {
+// user's start G-code, before any ;TYPE: or under "Custom"). Fills r.steepest_deg. `also`
+// (if any) gets every move read, for a caller that wants them in the same reading.
+bool slopes(SliceResult& r, const LayerParams& L, const GateParams& g, const Violation& violation,
+            const std::function<void(const GcodeMove&)>& also) {
   const double tan_max = std::tan((L.max_angle_deg + g.angle_slack_deg) * M_PI / 180.0);
   double steepest = 0;
   bool go_on = true;
   for_each_gcode_move(r.gcode, [&](const GcodeMove& m) {
+    if (also) also(m);
     if (!go_on || m.layer < 0 || !m.extruding() || m.type.empty() || m.type == "Custom" ||
         role_from_name(m.type) == ExtrusionRole::skirt)
       return;
@@ -98,16 +105,15 @@ bool slopes(SliceResult& r, const LayerParams& L, const GateParams& g, const Vio
 // measures it), among the moves `keep` accepts (null: all): where a layer is curved, the
 // crossings thinner than h_min less g's slack go to `thin`, in file order (flat layers are
 // the planar engine's; too thick is the paths' heights' to judge: a line over a gap by design,
-// sparse infill or a bridge, crosses lines more than a layer down). Gives up when `abandon`
-// turns true. Fills r's thickness figures (check's, to the digit).
-void crossings(SliceResult& r, const LayerParams& L, const GateParams& g,
-               const std::function<bool(const GcodeMove&)>& keep, const std::atomic<bool>& abandon,
-               std::vector<Vec3>& thin) {
+// sparse infill or a bridge, crosses lines more than a layer down), among `moves`. Gives up
+// when `abandon` turns true. Fills r's thickness figures (check's, to the digit).
+void crossings(SliceResult& r, const LayerParams& L, const GateParams& g, const MoveReplay& moves,
+               const std::atomic<bool>& abandon, std::vector<Vec3>& thin) {
   LayerGaps gaps([&](const CrossingGap& c) {
     if (c.curved && c.gap < L.min_layer_height - g.thickness_slack) thin.push_back(c.at);
     return !abandon.load(std::memory_order_relaxed);
   });
-  for_each_print_move(r.gcode, keep, [&](const PrintMove& m) {
+  moves([&](const PrintMove& m) {
     if (!abandon.load(std::memory_order_relaxed)) gaps.add(m);
   });
   gaps.finish();
@@ -138,21 +144,45 @@ Expected<bool> gate(SliceResult& r, const SliceJob& job, const layers::BandedFie
       return banded ? zones.may_matter(m, m.layer)
                     : late.may_matter(std::max(m.from.z(), m.to.z()), m.layer);
     };
+  // The moves that matter, held when the program is small, taken from the slopes' reading:
+  // the crossings and the collision search's two passes then read memory, not text (the gate
+  // read the sine roof's 2.4 MB five times, now twice; its gate's wall time went from 53 to
+  // about 40 ms). Read from the text by each pass when it is large: the bunny's 690 000 kept
+  // moves would be 72 MB at its peak.
+  const MoveReplay from_text = [&](const std::function<void(const PrintMove&)>& f) {
+    for_each_print_move(r.gcode, keep, f);
+  };
+  std::vector<PrintMove> held;
+  const std::size_t g_lines = r.nonplanar ? count_gcode_lines(r.gcode).g_lines : 0;
+  const bool hold = r.nonplanar && g_lines <= kHeldMoves;
+  const MoveReplay moves = !hold ? from_text : [&](const std::function<void(const PrintMove&)>& f) {
+    for (const PrintMove& m : held) f(m);
+  };
   // The crossings on the other core while this one reads the slopes and searches for
   // collisions (on the bunny they took 0.7 s); then the file's time and filament
   // (with_print_stats' reading: 0.9 s on the bunny), kept when this program is the one
-  // written (r.stats_in_gcode).
+  // written (r.stats_in_gcode). Held moves are there only after the slopes' reading: the
+  // file's time is measured first.
   std::atomic<bool> abandon{false};
   std::vector<Vec3> thin;
   PrintStatsStamp stamp;
   core::Background beside;
-  beside.run([&] { crossings(r, job.layers, job.gate, keep, abandon, thin); });
+  auto cross = [&] { crossings(r, job.layers, job.gate, moves, abandon, thin); };
+  if (!hold) beside.run(cross);
   if (r.nonplanar) beside.run([&] { stamp = measure_print_stats(r.gcode, job.print); });
-  if (!slopes(r, job.layers, job.gate, violation)) {
+  std::function<void(const GcodeMove&)> hold_move;
+  if (hold) {
+    reserve_huge(held, g_lines);
+    hold_move = [&](const GcodeMove& m) {
+      if (!keep || keep(m)) held.push_back(print_move(m));
+    };
+  }
+  if (!slopes(r, job.layers, job.gate, violation, hold_move)) {
     abandon = true;
     beside.wait();
     return false;
   }
+  if (hold) beside.run(cross);
   auto thin_ones = [&] {
     for (const Vec3& p : thin)
       if (!violation(p, "a layer crosses the one under it thinner than h_min")) return false;
@@ -173,11 +203,6 @@ Expected<bool> gate(SliceResult& r, const SliceJob& job, const layers::BandedFie
                          [&](const BoundingBox& b) { return b.contains(p); });
     };
   if (!banded) looked_at = [&](const Vec3& p) { return late.looked_at(p); };
-  // Read from the text twice (the extrusions' box, then the search) rather than held: on the
-  // bunny the moves were 110 MB at the slice's peak; its slice took no longer so.
-  const MoveReplay moves = [&](const std::function<void(const PrintMove&)>& f) {
-    for_each_print_move(r.gcode, keep, f);
-  };
   auto figures = find_collisions(moves, job.check, looked_at, ctx);
   beside.wait();
   if (!figures) return figures.error();

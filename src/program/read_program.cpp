@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstring>
 #include <optional>
 #include <string>
 
@@ -312,14 +313,14 @@ void Reader::move(core::Tokenizer& tok, GcodeLine& item, bool in_print) {
   p_.moves.push_back(m);
 }
 
+}  // namespace
+
 PrintMove print_move(const GcodeMove& g) {
   PrintMove m;
   m.from = g.from, m.to = g.to, m.filament = g.de, m.extruding = g.extruding(), m.wipe = g.wipe;
   m.type = g.type, m.layer = g.layer, m.width = g.width, m.line = g.line;
   return m;
 }
-
-}  // namespace
 
 GcodeProgram read_gcode_program(std::string_view text) {
   GcodeProgram p;
@@ -343,11 +344,13 @@ std::vector<GcodeProblem> for_each_gcode_move(std::string_view text,
 
 GcodeLineCount count_gcode_lines(std::string_view text) {
   // As for_each_line splits: a last line without its line end counts, an empty end does not.
+  // Line to line by memchr: a loop over every byte was two thirds of the reader's own time.
   GcodeLineCount n;
-  bool at_start = true;
-  for (const char c : text) {
-    if (at_start) ++n.lines, n.g_lines += (c | 0x20) == 'g';
-    at_start = c == '\n';
+  for (std::size_t at = 0; at < text.size();) {
+    ++n.lines, n.g_lines += (text[at] | 0x20) == 'g';
+    const void* end = std::memchr(text.data() + at, '\n', text.size() - at);
+    if (!end) break;
+    at = static_cast<std::size_t>(static_cast<const char*>(end) - text.data()) + 1;
   }
   return n;
 }

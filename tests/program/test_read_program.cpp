@@ -218,5 +218,21 @@ TEST(ProgramLayer, StepsAreWrittenInOrderAndFollowE) {
   EXPECT_TRUE(refused.fault);
 }
 
+// Lines as the reader splits them (a last line without its end counts, an empty end does
+// not), and the G lines among them (the reservation for the moves).
+TEST(ReadProgram, LinesAndGLinesCounted) {
+  struct Case {
+    const char* text;
+    std::size_t lines, g_lines;
+  };
+  for (const Case& c : {Case{"", 0, 0}, Case{"G1", 1, 1}, Case{"G1\n", 1, 1}, Case{"\n\n", 2, 0},
+                        Case{"g1 X1\r\nM83\nG1 Y2", 3, 2}, Case{";G1\n G1\nG", 3, 1}}) {
+    const GcodeLineCount n = count_gcode_lines(c.text);
+    EXPECT_EQ(n.lines, c.lines) << c.text;
+    EXPECT_EQ(n.g_lines, c.g_lines) << c.text;
+    EXPECT_EQ(read_gcode_program(c.text).lines.size(), c.lines) << c.text;
+  }
+}
+
 }  // namespace
 }  // namespace nonplanar
