@@ -157,49 +157,45 @@ Figures measure(const StackGrid& g, const Eigen::MatrixXd& Z, const LayerParams&
 
 }  // namespace
 
-StackResult build_stack(const TriangleMesh& mesh, const Patch& patch, int patch_id,
-                        const HeightField& top, const ColumnCaster& columns, const LayerParams& p,
-                        const PlanarLayers& planar, double initial_power, const Context& ctx) {
-  StackResult out;
+StackStart start_stack(const TriangleMesh& mesh, const Patch& patch, int patch_id,
+                       const HeightField& top, const ColumnCaster& columns, const LayerParams& p,
+                       const PlanarLayers& planar) {
+  StackStart s;
+  StackResult& out = s.result;
   // Without a fitted surface, only the checks the facets decide (build_stack's header).
   const bool fitted = !top.surface.points.empty();
-  if (!fitted && !p.faceted_top) return out.needs_fit = true, out;
+  if (!fitted && !p.faceted_top) return out.needs_fit = true, s;
   LayerStack& st = out.stack;
   st.patch = patch_id;
   st.xy_min = patch.xy_min;
   st.xy_max = patch.xy_max;
-  const PatchRaster raster = rasterize_patch(mesh, patch, std::max(0.1, p.grid_step / 2), 0.0);
-  // Figures on a fine grid; the optimiser's quadrature on one of about 40 × 40 points.
-  StackGrid grid, coarse;
-  const double step = std::max(p.grid_step, std::max(top.extent.x(), top.extent.y()) / 100.0);
-  build_stack_grid(grid, top, step, raster.mask, raster.origin, raster.cell, raster.nx, raster.ny);
-  // ... but at least two samples per knot span, or the layers could wiggle between samples.
-  double span = 1e300;
-  for (std::size_t i = 0; i + 1 < top.surface.U.size(); ++i)
-    if (top.surface.U[i + 1] > top.surface.U[i])
-      span = std::min(span, (top.surface.U[i + 1] - top.surface.U[i]) * top.extent.x());
-  for (std::size_t i = 0; i + 1 < top.surface.V.size(); ++i)
-    if (top.surface.V[i + 1] > top.surface.V[i])
-      span = std::min(span, (top.surface.V[i + 1] - top.surface.V[i]) * top.extent.y());
-  const double coarse_step =
-      std::max(step, std::min(std::max(top.extent.x(), top.extent.y()) / 40.0, span / 2.0));
-  if (fitted)
-    build_stack_grid(coarse, top, coarse_step, raster.mask, raster.origin, raster.cell, raster.nx,
-                     raster.ny);
+  s.raster = rasterize_patch(mesh, patch, std::max(0.1, p.grid_step / 2), 0.0);
+  const PatchRaster& raster = s.raster;
+  // Figures on a fine grid (the optimiser's quadrature is finish_stack's).
+  StackGrid& grid = s.grid;
+  s.fitted = fitted, s.origin = top.origin, s.extent = top.extent;
+  s.step = std::max(p.grid_step, std::max(top.extent.x(), top.extent.y()) / 100.0);
+  build_stack_grid(grid, top, s.step, raster.mask, raster.origin, raster.cell, raster.nx,
+                   raster.ny);
 
   // Heights of the top over the whole rectangle (the stack must be valid where it blends).
   // It follows the facets (the band's raster, built last, carries them past the rim).
   const int n = static_cast<int>(grid.xy.size());
-  std::vector<double> top_z(n), top_tan(n, 0.0), H;
-  std::vector<Vec2> dH;
+  std::vector<double> top_z(n), top_tan(n, 0.0);
+  std::vector<double>& H = s.H;
+  std::vector<Vec2>& dH = s.dH;
   FacetSamples fs;
   if (p.faceted_top) {
     fs = facet_samples(mesh, patch, grid.xy, grid.on_patch);
     H.resize(n), dH.resize(n);
     for (int k = 0; k < n; ++k) {
       const bool ok = std::isfinite(fs.h[k]) && fs.slope[k].allFinite();
-      if (!ok && !fitted && grid.on_patch[k]) return out.needs_fit = true, out;
-      if (!ok && !fitted) continue;  // off the patch: read after the checks below only
+      if (!ok && !fitted && grid.on_patch[k]) return out.needs_fit = true, s;
+      // Off the patch: read after the checks below only (finish_stack, from the fit).
+      if (!ok && !fitted) {
+        s.off_facets.push_back(k);
+        continue;
+      }
       H[k] = ok ? fs.h[k] : top.height(grid.xy[k].x(), grid.xy[k].y());
       dH[k] = ok ? fs.slope[k] : top.gradient(grid.xy[k].x(), grid.xy[k].y());
     }
@@ -225,12 +221,12 @@ StackResult build_stack(const TriangleMesh& mesh, const Patch& patch, int patch_
   if (p.faceted_top) zmin = std::min(zmin, fs.h_lo), zmax = std::max(zmax, fs.h_hi);
   if (on_count == 0) {
     out.failure = "patch covers no sample of its grid";
-    return out;
+    return s;
   }
   if (top_slope > p.max_angle_deg) {
     out.failure =
         fmt2("surface slope %.1f deg exceeds max_angle %.1f deg", top_slope, p.max_angle_deg);
-    return out;
+    return s;
   }
   // c: deep enough that (relief + d) / d ≤ h_max / h_min, on a planar boundary.
   const double relief = zmax - zmin;
@@ -245,7 +241,7 @@ StackResult build_stack(const TriangleMesh& mesh, const Patch& patch, int patch_
         "relief %.2f mm needs the stack's plane %.2f mm below the surface's lowest "
         "point, which is below the first layer",
         relief, d_req);
-    return out;
+    return s;
   }
   // N for a plane c: about h thick on average, within the thickness limits with a margin.
   const double mean_top = on_sum / on_count;
@@ -296,7 +292,7 @@ StackResult build_stack(const TriangleMesh& mesh, const Patch& patch, int patch_
         "relief %.2f mm cannot be split into layers within the thickness limits "
         "(%.2f mm below the patch)",
         relief, D_min);
-    return out;
+    return s;
   }
   st.layers = N;
   // Material: solid from c up to the top under the patch, nothing just above it.
@@ -317,37 +313,77 @@ StackResult build_stack(const TriangleMesh& mesh, const Patch& patch, int patch_
     if (!meets_top) continue;  // a sample at the patch's rim, just off the part
     if (!solid) {
       out.failure = fmt2("part is not solid from z = %.2f up to the patch at x = %.2f", st.c, x);
-      return out;
+      return s;
     }
     if (above) {
       out.failure =
           fmt2("other material of the part lies above the patch at x = %.2f, y = %.2f", x, y);
-      return out;
+      return s;
     }
   }
-  if (!fitted) return out.needs_fit = true, out;
-
-  // How far the curved layers sit from the planar ones decides how gently they blend. The
-  // blend's raster and the band's faceted top depend only on that, so they are built while
-  // the optimiser runs (on FoilCutter each takes about as long as a tenth of the slice).
+  // How far the curved layers sit from the planar ones decides how gently they blend.
   double dev = 0;
   for (int kk = 0; kk < n; ++kk)
     if (grid.on_patch[kk]) dev = std::max(dev, std::abs(top_z[kk] - (st.c + N * p.layer_height)));
-  const double fade = std::max(1.0, 4.5 * dev);
-  const double blend = std::max(2.0, 1.3 * 1.5 * dev / std::tan(p.max_angle_deg * kDeg));
-  PatchRaster wide;
-  FacetedTop band_facets;
-  Background background;
-  background.run([&] {
-    wide = rasterize_patch(mesh, patch, std::max(0.25, p.grid_step / 2), blend + 2.0);
-    // β reaches two of its cells past its raster. Off the patch the top may bend no steeper
-    // than 0.8 max_angle along the raster's axes, so its bilinear interpolation (whose
-    // gradient can be √2 times that) stays printable: on the bunny a single-facet patch's
-    // continuation made a 31° path 1 mm past its corner.
-    if (p.faceted_top)
-      band_facets = faceted_top(mesh, patch, 0.1, blend + 2.0 + 3 * wide.cell,
+  s.fade = std::max(1.0, 4.5 * dev);
+  s.blend = std::max(2.0, 1.3 * 1.5 * dev / std::tan(p.max_angle_deg * kDeg));
+  s.zmin = zmin, s.zmax = zmax;
+  s.passed = true;
+  out.needs_fit = !fitted;
+  return s;
+}
+
+void prepare_blend(StackStart& s, const TriangleMesh& mesh, const Patch& patch,
+                   const LayerParams& p) {
+  s.wide = rasterize_patch(mesh, patch, std::max(0.25, p.grid_step / 2), s.blend + 2.0);
+  // β reaches two of its cells past its raster. Off the patch the top may bend no steeper
+  // than 0.8 max_angle along the raster's axes, so its bilinear interpolation (whose
+  // gradient can be √2 times that) stays printable: on the bunny a single-facet patch's
+  // continuation made a 31° path 1 mm past its corner.
+  if (p.faceted_top)
+    s.band_facets = faceted_top(mesh, patch, 0.1, s.blend + 2.0 + 3 * s.wide.cell,
                                 std::tan(0.8 * p.max_angle_deg * kDeg) / M_SQRT2);
-  });
+  s.blend_ready = true;
+}
+
+StackResult finish_stack(StackStart s, const TriangleMesh& mesh, const Patch& patch,
+                         const HeightField& top, const LayerParams& p, double initial_power,
+                         const Context& ctx) {
+  StackResult out = std::move(s.result);
+  out.needs_fit = false;
+  LayerStack& st = out.stack;
+  const int N = st.layers;
+  const double zmin = s.zmin, zmax = s.zmax;
+  const PatchRaster& raster = s.raster;
+  StackGrid& grid = s.grid;
+  std::vector<double>& H = s.H;
+  std::vector<Vec2>& dH = s.dH;
+  if (!s.fitted) {  // the checks read the rectangle: the same samples, now with the fit's basis
+    build_stack_grid(grid, top, s.step, raster.mask, raster.origin, raster.cell, raster.nx,
+                     raster.ny);
+    for (const int k : s.off_facets)
+      H[k] = top.height(grid.xy[k].x(), grid.xy[k].y()),
+      dH[k] = top.gradient(grid.xy[k].x(), grid.xy[k].y());
+  }
+  // The optimiser's quadrature on a grid of about 40 × 40 points, but at least two samples
+  // per knot span, or the layers could wiggle between samples.
+  StackGrid coarse;
+  double span = 1e300;
+  for (std::size_t i = 0; i + 1 < top.surface.U.size(); ++i)
+    if (top.surface.U[i + 1] > top.surface.U[i])
+      span = std::min(span, (top.surface.U[i + 1] - top.surface.U[i]) * top.extent.x());
+  for (std::size_t i = 0; i + 1 < top.surface.V.size(); ++i)
+    if (top.surface.V[i + 1] > top.surface.V[i])
+      span = std::min(span, (top.surface.V[i + 1] - top.surface.V[i]) * top.extent.y());
+  const double coarse_step =
+      std::max(s.step, std::min(std::max(top.extent.x(), top.extent.y()) / 40.0, span / 2.0));
+  build_stack_grid(coarse, top, coarse_step, raster.mask, raster.origin, raster.cell, raster.nx,
+                   raster.ny);
+  // The blend's raster and the band's faceted top depend only on the facets, so they are built
+  // while the optimiser runs, if not already (fit_for_plan builds them while the top is
+  // fitted; on FoilCutter each takes about as long as a tenth of the slice).
+  Background background;
+  if (!s.blend_ready) background.run([&] { prepare_blend(s, mesh, patch, p); });
 
   // Starting stack and optimisation of the intermediate control heights.
   const int nc = top.surface.n_u * top.surface.n_v;
@@ -452,9 +488,9 @@ StackResult build_stack(const TriangleMesh& mesh, const Patch& patch, int patch_
     return out;
   }
   for (int i = 0; i <= N; ++i) {
-    HeightField s = top;
-    for (int j = 0; j < nc; ++j) s.surface.points[j].z() = best(i, j);
-    st.surfaces.push_back(std::move(s));
+    HeightField layer = top;
+    for (int j = 0; j < nc; ++j) layer.surface.points[j].z() = best(i, j);
+    st.surfaces.push_back(std::move(layer));
   }
   Band& b = out.band;
   b.top = top;
@@ -466,11 +502,19 @@ StackResult build_stack(const TriangleMesh& mesh, const Patch& patch, int patch_
   // The top's range over the patch bounds it elsewhere (see Band::top_lo); a hair of slack
   // so points between grid samples on the patch are never touched.
   b.top_lo = zmin - 0.01, b.top_hi = zmax + 0.01;
-  b.fade = fade;
+  b.fade = s.fade;
   background.wait();
-  set_blend(b, wide, blend);
-  b.facets = std::move(band_facets);
+  set_blend(b, s.wide, s.blend);
+  b.facets = std::move(s.band_facets);
   return out;
+}
+
+StackResult build_stack(const TriangleMesh& mesh, const Patch& patch, int patch_id,
+                        const HeightField& top, const ColumnCaster& columns, const LayerParams& p,
+                        const PlanarLayers& planar, double initial_power, const Context& ctx) {
+  StackStart s = start_stack(mesh, patch, patch_id, top, columns, p, planar);
+  if (!s.passed || s.result.needs_fit) return std::move(s.result);
+  return finish_stack(std::move(s), mesh, patch, top, p, initial_power, ctx);
 }
 
 }  // namespace nonplanar::layers

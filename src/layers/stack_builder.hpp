@@ -8,6 +8,9 @@
 
 #include "core/column_caster.hpp"
 #include "layers/banded_field.hpp"
+#include "layers/faceted_top.hpp"
+#include "layers/patch_raster.hpp"
+#include "layers/printability_cost.hpp"
 
 namespace nonplanar::layers {
 
@@ -19,6 +22,45 @@ struct StackResult {
   /// sample of the patch lies off them); build it again with the fitted surface.
   bool needs_fit = false;
 };
+
+/// What build_stack decides before its optimiser: the checks (slope, relief, the plane c and
+/// count N, material under and above the patch), and what they leave for finish_stack. With
+/// LayerParams::faceted_top these read the facets only, so they run on the patch's rectangle
+/// unfitted (fit_rectangle) and the rest resumes once the fit is there (fit_for_plan: the
+/// checks were done twice and the blend's rasters waited on, a fifth of the sine roof's slice).
+struct StackStart {
+  StackResult result;   ///< refused (failure), or needs_fit as build_stack says
+  bool passed = false;  ///< every check passed: finish_stack may go on from here
+  // What finish_stack goes on from.
+  bool fitted = false;              ///< the checks read a fitted top (the grid has its basis)
+  Vec2 origin{0, 0}, extent{0, 0};  ///< of the top the checks read (the grid's rectangle)
+  double step = 0;                  ///< the fine grid's spacing, mm
+  PatchRaster raster;               ///< the patch's own, for the grids' masks
+  StackGrid grid;                   ///< the fine grid (its basis only when fitted)
+  std::vector<double> H;            ///< the faceted top at the grid's samples (faceted_top)
+  std::vector<Vec2> dH;             ///< and its gradient
+  std::vector<int> off_facets;      ///< samples off the facets, read from the fit when there
+  double zmin = 0, zmax = 0;        ///< the top's range over the patch, mm
+  double fade = 0, blend = 0;       ///< the band's fade and blend widths, mm
+  // The blend's raster and the band's faceted top (prepare_blend), built once.
+  bool blend_ready = false;
+  PatchRaster wide;
+  FacetedTop band_facets;
+};
+
+/// build_stack's checks (see there); `top` fitted or the rectangle unfitted.
+StackStart start_stack(const TriangleMesh& mesh, const Patch& patch, int patch_id,
+                       const HeightField& top, const ColumnCaster& columns,
+                       const LayerParams& params, const PlanarLayers& planar);
+/// The blend's raster and the band's faceted top for a start that passed: they depend only
+/// on the facets and the start's figures, so they can be built while the top is fitted.
+void prepare_blend(StackStart& start, const TriangleMesh& mesh, const Patch& patch,
+                   const LayerParams& params);
+/// The rest of build_stack from a start that passed, with the patch's fitted `top` (whose
+/// rectangle is the start's): the optimiser, the figures, the band.
+StackResult finish_stack(StackStart start, const TriangleMesh& mesh, const Patch& patch,
+                         const HeightField& top, const LayerParams& params, double initial_power,
+                         const Context& ctx);
 
 /// top: the patch's fitted surface; or its rectangle unfitted (fit_rectangle, no control
 /// points), for the checks the facets decide with LayerParams::faceted_top (slope, relief,

@@ -185,8 +185,23 @@ void expect_plan_without_refused_fits(const TriangleMesh& mesh, int refused, int
   for (std::size_t i = 0; i < plan->stacks.size(); ++i) {
     EXPECT_EQ(plan->stacks[i].patch, all.plan.stacks[i].patch);
     EXPECT_EQ(plan->stacks[i].c, all.plan.stacks[i].c);
+    EXPECT_EQ(plan->stacks[i].layers, all.plan.stacks[i].layers);
     EXPECT_EQ(plan->stacks[i].thickness_min, all.plan.stacks[i].thickness_min);
+    EXPECT_EQ(plan->stacks[i].thickness_max, all.plan.stacks[i].thickness_max);
+    EXPECT_EQ(plan->stacks[i].max_slope_deg, all.plan.stacks[i].max_slope_deg);
+    EXPECT_EQ(plan->stacks[i].cost_after, all.plan.stacks[i].cost_after);
   }
+  // The stacks resumed from the facets' checks (their blend rasters built beside the fits)
+  // make the very field the whole build makes: T to the last bit over the part's box.
+  const BoundingBox box = bounding_box(all.mesh);
+  int differ = 0, samples = 0;
+  for (int i = 0; i <= 40; ++i)
+    for (int j = 0; j <= 40; ++j)
+      for (int k = 0; k <= 40; ++k, ++samples) {
+        const Vec3 q = box.min + (box.max - box.min).cwiseProduct(Vec3(i, j, k) / 40.0);
+        differ += plan->field->T(q.x(), q.y(), q.z()) != all.plan.field->T(q.x(), q.y(), q.z());
+      }
+  EXPECT_EQ(differ, 0) << "of " << samples;
   ASSERT_EQ(plan->fallbacks.size(), all.plan.fallbacks.size());
   for (std::size_t i = 0; i < plan->fallbacks.size(); ++i) {
     EXPECT_EQ(plan->fallbacks[i].patch, all.plan.fallbacks[i].patch);
@@ -212,6 +227,7 @@ TEST(Layers, PatchesTheFacetsRefuseAreNotFitted) {
   expect_plan_without_refused_fits(test::rib_and_domed_tower(), 1, 1);
   expect_plan_without_refused_fits(test::hollow_roof(1.5), 1, 0);
   expect_plan_without_refused_fits(towers(), 0, 2);
+  expect_plan_without_refused_fits(test::sine_roof(), 0, 1);
 }
 
 // FoilCutter's fit swings off its patch, where its layers broke the limits with penalties no
