@@ -2,6 +2,7 @@
 // be what printf's %.3f and %.5f write, byte for byte, or every file would change.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdio>
 #include <random>
 #include <string>
@@ -41,6 +42,18 @@ TEST(GcodeText, NumbersAreWhatPrintfWrites) {
     const double x = pos(rng), y = pos(rng), z = pos(rng) / 10, de = e(rng);
     ASSERT_EQ(written(x, y, z, de), printf_move(x, y, z, de)) << x << " " << y << " " << de;
   }
+  // Near the ties of the last digit, where the integers' fast path must step aside: k
+  // thousandths plus half of one, give or take a few units in the last place.
+  std::uniform_int_distribution<int> thousandths(-300000, 300000), ulps(-4, 4);
+  for (int k = 0; k < 200000; ++k) {
+    double v = (thousandths(rng) + 0.5) / 1000;
+    for (int u = ulps(rng); u != 0; u += u > 0 ? -1 : 1) v = std::nextafter(v, u > 0 ? 1e9 : -1e9);
+    const double e5 = v / 100;  // ties of the fifth decimal
+    ASSERT_EQ(written(v, v, v, e5), printf_move(v, v, v, e5)) << v;
+  }
+  // Past the fast path's range (10^9 units of the last digit) and non-finite.
+  for (const double v : {1e6 + 0.0004, 1e7 + 0.25, -4e6 - 0.0006, 12345.678905, -9999.999995})
+    EXPECT_EQ(written(v, v, v, v), printf_move(v, v, v, v)) << v;
 }
 
 }  // namespace
