@@ -27,7 +27,6 @@ double reference(const std::string& t) {
 // aside.
 TEST(TextTokens, PlainDecimalsReadAsFromCharsReadsThem) {
   std::mt19937_64 rng(7);
-  int checked = 0;
   for (int n = 0; n < 200000; ++n) {
     const int digits = 1 + static_cast<int>(rng() % 19);
     std::string t = rng() % 3 == 0 ? "-" : rng() % 5 == 0 ? "+" : "";
@@ -41,9 +40,7 @@ TEST(TextTokens, PlainDecimalsReadAsFromCharsReadsThem) {
     const double r = reference(t);
     ASSERT_EQ(std::signbit(*v), std::signbit(r)) << t;
     ASSERT_EQ(*v, r) << t;
-    ++checked;
   }
-  EXPECT_EQ(checked, 200000);
 }
 
 TEST(TextTokens, OtherNumbersAndGarbage) {
