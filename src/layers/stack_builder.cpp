@@ -346,6 +346,76 @@ void prepare_blend(StackStart& s, const TriangleMesh& mesh, const Patch& patch,
   s.blend_ready = true;
 }
 
+namespace {
+
+bool same_top(const HeightField& a, const HeightField& b) {
+  const NurbsSurface &u = a.surface, &v = b.surface;
+  return a.origin == b.origin && a.extent == b.extent && u.p == v.p && u.q == v.q && u.U == v.U &&
+         u.V == v.V && u.points == v.points && u.weights == v.weights;
+}
+
+// The optimiser's quadrature on a grid of about 40 × 40 points, but at least two samples per
+// knot span, or the layers could wiggle between samples; with the cost's round stand-in for
+// the head, its lowest part over the block's disk (the rise check uses the whole shape).
+std::shared_ptr<const StackStart::Coarse> coarse_grid(const StackStart& s, const HeightField& top,
+                                                      const LayerParams& p) {
+  auto c = std::make_shared<StackStart::Coarse>();
+  c->on = top;
+  double span = 1e300;
+  for (std::size_t i = 0; i + 1 < top.surface.U.size(); ++i)
+    if (top.surface.U[i + 1] > top.surface.U[i])
+      span = std::min(span, (top.surface.U[i + 1] - top.surface.U[i]) * top.extent.x());
+  for (std::size_t i = 0; i + 1 < top.surface.V.size(); ++i)
+    if (top.surface.V[i + 1] > top.surface.V[i])
+      span = std::min(span, (top.surface.V[i + 1] - top.surface.V[i]) * top.extent.y());
+  const double step =
+      std::max(s.step, std::min(std::max(top.extent.x(), top.extent.y()) / 40.0, span / 2.0));
+  const PatchRaster& r = s.raster;
+  build_stack_grid(c->grid, top, step, r.mask, r.origin, r.cell, r.nx, r.ny);
+  c->grid.pair_within(std::min(p.toolhead.block_radius, p.toolhead.reach()), 2.0);
+  return c;
+}
+
+// S_i = (1 − a_i) S_f + a_i c, a_i = (i/N)^power, as control heights (layers × controls).
+Eigen::MatrixXd starting_stack(const HeightField& top, int N, double c, double power) {
+  const int nc = top.surface.n_u * top.surface.n_v;
+  Eigen::MatrixXd Z(N + 1, nc);
+  for (int i = 0; i <= N; ++i) {
+    const double a = std::pow(static_cast<double>(i) / N, power);
+    for (int j = 0; j < nc; ++j) Z(i, j) = (1 - a) * top.surface.points[j].z() + a * c;
+  }
+  return Z;
+}
+
+// A quadratic penalty always tolerates a small overshoot, so it aims 5 µm inside the limits;
+// the figures are then checked against the limits themselves.
+CostTerms cost_terms(const LayerParams& p) {
+  const double inset = 0.005;
+  return CostTerms{p.layer_height,
+                   p.min_layer_height + inset,
+                   p.max_layer_height - inset,
+                   p.continuity_weight,
+                   1e5,
+                   std::tan(p.max_angle_deg * kDeg) - 0.01,
+                   p.toolhead.clearance() - 0.05};
+}
+
+}  // namespace
+
+bool stays_even(StackStart& s, const HeightField& top, const LayerParams& p) {
+  const int N = s.result.stack.layers;
+  if (N < 2 || p.max_iterations <= 0) return true;
+  if (!s.coarse || !same_top(s.coarse->on, top)) s.coarse = coarse_grid(s, top, p);
+  const Eigen::MatrixXd Z = starting_stack(top, N, s.result.stack.c, 1.0);
+  const CostTerms terms = cost_terms(p);
+  Eigen::MatrixXd grad;
+  printability_cost(s.coarse->grid, Z, terms, &grad);
+  // Ceres' GradientProblemSolver stops at once when the gradient's max norm is at most its
+  // gradient_tolerance (1e-10 by default, finish_stack's).
+  return grad.size() == 0 || grad.lpNorm<Eigen::Infinity>() <=
+                                 ceres::GradientProblemSolver::Options().gradient_tolerance;
+}
+
 StackResult finish_stack(StackStart s, const TriangleMesh& mesh, const Patch& patch,
                          const HeightField& top, const LayerParams& p, double initial_power,
                          const Context& ctx) {
@@ -365,20 +435,8 @@ StackResult finish_stack(StackStart s, const TriangleMesh& mesh, const Patch& pa
       H[k] = top.height(grid.xy[k].x(), grid.xy[k].y()),
       dH[k] = top.gradient(grid.xy[k].x(), grid.xy[k].y());
   }
-  // The optimiser's quadrature on a grid of about 40 × 40 points, but at least two samples
-  // per knot span, or the layers could wiggle between samples.
-  StackGrid coarse;
-  double span = 1e300;
-  for (std::size_t i = 0; i + 1 < top.surface.U.size(); ++i)
-    if (top.surface.U[i + 1] > top.surface.U[i])
-      span = std::min(span, (top.surface.U[i + 1] - top.surface.U[i]) * top.extent.x());
-  for (std::size_t i = 0; i + 1 < top.surface.V.size(); ++i)
-    if (top.surface.V[i + 1] > top.surface.V[i])
-      span = std::min(span, (top.surface.V[i + 1] - top.surface.V[i]) * top.extent.y());
-  const double coarse_step =
-      std::max(s.step, std::min(std::max(top.extent.x(), top.extent.y()) / 40.0, span / 2.0));
-  build_stack_grid(coarse, top, coarse_step, raster.mask, raster.origin, raster.cell, raster.nx,
-                   raster.ny);
+  if (!s.coarse || !same_top(s.coarse->on, top)) s.coarse = coarse_grid(s, top, p);
+  const StackGrid& coarse = s.coarse->grid;
   // The blend's raster and the band's faceted top depend only on the facets, so they are built
   // while the optimiser runs, if not already (fit_for_plan builds them while the top is
   // fitted; on FoilCutter each takes about as long as a tenth of the slice).
@@ -387,24 +445,8 @@ StackResult finish_stack(StackStart s, const TriangleMesh& mesh, const Patch& pa
 
   // Starting stack and optimisation of the intermediate control heights.
   const int nc = top.surface.n_u * top.surface.n_v;
-  Eigen::MatrixXd Z(N + 1, nc);
-  for (int i = 0; i <= N; ++i) {
-    const double a = std::pow(static_cast<double>(i) / N, initial_power);
-    for (int j = 0; j < nc; ++j) Z(i, j) = (1 - a) * top.surface.points[j].z() + a * st.c;
-  }
-  // A quadratic penalty always tolerates a small overshoot, so it aims 5 µm inside the
-  // limits; the figures below are then checked against the limits themselves.
-  const double inset = 0.005;
-  const CostTerms terms{p.layer_height,
-                        p.min_layer_height + inset,
-                        p.max_layer_height - inset,
-                        p.continuity_weight,
-                        1e5,
-                        std::tan(p.max_angle_deg * kDeg) - 0.01,
-                        p.toolhead.clearance() - 0.05};
-  // The cost's round stand-in for the head: its lowest part over the block's disk (the
-  // rise check below uses the whole shape).
-  coarse.pair_within(std::min(p.toolhead.block_radius, p.toolhead.reach()), 2.0);
+  Eigen::MatrixXd Z = starting_stack(top, N, st.c, initial_power);
+  const CostTerms terms = cost_terms(p);
   // Each evaluation costs as much as the rest of the stack on a large patch (the bunny's
   // took 3 of them for an optimiser that found the even stack already optimal: the even
   // interpolation makes every t_ik and every gradient difference equal, so eq. 1's terms have

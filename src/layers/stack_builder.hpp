@@ -4,6 +4,7 @@
 
 #include "nonplanar/context.hpp"
 
+#include <memory>
 #include <string>
 
 #include "core/column_caster.hpp"
@@ -46,6 +47,13 @@ struct StackStart {
   bool blend_ready = false;
   PatchRaster wide;
   FacetedTop band_facets;
+  /// The optimiser's grid of about 40 × 40 samples, built on `on` (stays_even's; finish_stack
+  /// takes it when its top is that one, else builds its own).
+  struct Coarse {
+    HeightField on;
+    StackGrid grid;
+  };
+  std::shared_ptr<const Coarse> coarse;
 };
 
 /// build_stack's checks (see there); `top` fitted or the rectangle unfitted.
@@ -56,6 +64,13 @@ StackStart start_stack(const TriangleMesh& mesh, const Patch& patch, int patch_i
 /// on the facets and the start's figures, so they can be built while the top is fitted.
 void prepare_blend(StackStart& start, const TriangleMesh& mesh, const Patch& patch,
                    const LayerParams& params);
+/// Whether the optimiser would leave the even stack over `top` (fitted, the start's rectangle)
+/// as it is: its cost's gradient there is under the solver's tolerance, as it is unless a limit
+/// is active (the even interpolation makes every t_ik and every gradient difference equal). Then
+/// with LayerParams::faceted_top the layers are c + (1 − i/N)(H − c), whatever the fit: a
+/// refinement of the fit would change nothing but rounding. Keeps the optimiser's grid in the
+/// start for finish_stack.
+bool stays_even(StackStart& start, const HeightField& top, const LayerParams& params);
 /// The rest of build_stack from a start that passed, with the patch's fitted `top` (whose
 /// rectangle is the start's): the optimiser, the figures, the band.
 StackResult finish_stack(StackStart start, const TriangleMesh& mesh, const Patch& patch,
