@@ -77,6 +77,61 @@ Under under_shell(const TriangleMesh& mesh, const std::vector<char>& in_patch, c
   return u;
 }
 
+// The shell's top: the patches' facets, and the printable facets joined to them (through
+// shared vertices, one after another) that no stack could take: those touching a curvature
+// jump (in no patch: a NURBS fit cannot follow them) and those of patches too small to fit. A
+// shell follows the facets themselves (H), so neither reason keeps them out of it: Benchy's
+// hull and deck, where 13 956 of its 22 254 printable facets touch a curvature jump, went from
+// 50 % of the curved top within 0.03 mm to 81 %. Flat patches stay out (the core lands on
+// them), and so do facets apart from the patches (the Voron ornament's, round its cap).
+Patch shell_top(const TriangleMesh& mesh, const Analysis& a, const std::vector<int>& patches) {
+  Patch P;
+  P.xy_min = Vec2::Constant(1e300), P.xy_max = Vec2::Constant(-1e300);
+  P.z_min = 1e300, P.z_max = -1e300;
+  for (int i : patches) {
+    const Patch& q = a.patches[static_cast<std::size_t>(i)];
+    P.faces.insert(P.faces.end(), q.faces.begin(), q.faces.end());
+    P.xy_min = P.xy_min.cwiseMin(q.xy_min), P.xy_max = P.xy_max.cwiseMax(q.xy_max);
+    P.z_min = std::min(P.z_min, q.z_min), P.z_max = std::max(P.z_max, q.z_max);
+  }
+  const std::size_t F = mesh.faces.size();
+  if (P.faces.empty() || a.painted.size() != F || a.face_patch.size() != F ||
+      a.discontinuous.size() != F)
+    return P;
+  // The candidates by vertex; a vertex of the top takes in every candidate round it.
+  std::vector<std::vector<int>> at(mesh.vertices.size());
+  for (std::size_t f = 0; f < F; ++f) {
+    if (!a.painted[f]) continue;
+    const int q = a.face_patch[f];
+    if (q < 0 ? a.discontinuous[f] != 0
+              : a.patches[static_cast<std::size_t>(q)].verdict == PatchVerdict::too_small)
+      for (int v : mesh.faces[f]) at[static_cast<std::size_t>(v)].push_back(static_cast<int>(f));
+  }
+  std::vector<char> in(F, 0), reached(mesh.vertices.size(), 0);
+  std::vector<int> todo;
+  auto reach = [&](int f) {
+    for (int v : mesh.faces[static_cast<std::size_t>(f)])
+      if (!reached[static_cast<std::size_t>(v)])
+        reached[static_cast<std::size_t>(v)] = 1, todo.push_back(v);
+  };
+  for (int f : P.faces) in[static_cast<std::size_t>(f)] = 1, reach(f);
+  while (!todo.empty()) {
+    const int v = todo.back();
+    todo.pop_back();
+    for (int f : at[static_cast<std::size_t>(v)]) {
+      if (in[static_cast<std::size_t>(f)]) continue;
+      in[static_cast<std::size_t>(f)] = 1, reach(f);
+      P.faces.push_back(f);
+      for (int w : mesh.faces[static_cast<std::size_t>(f)]) {
+        const Vec3& p = mesh.vertices[static_cast<std::size_t>(w)];
+        P.xy_min = P.xy_min.cwiseMin(p.head<2>()), P.xy_max = P.xy_max.cwiseMax(p.head<2>());
+        P.z_min = std::min(P.z_min, p.z()), P.z_max = std::max(P.z_max, p.z());
+      }
+    }
+  }
+  return P;
+}
+
 // R, the slack and g into the plan, and the notice of what the core prints of the patches.
 void take_region(ShellPlan& s, ShellRegion&& r) {
   s.left_out.clear();
@@ -175,16 +230,9 @@ ShellPlan plan_shell(const TriangleMesh& mesh, const Analysis& a, const std::vec
                      const LayerParams& p, double frame, bool even_core) {
   ShellPlan s;
   s.patches = patches;
-  // The patches as one: their facets, box and height range (what faceted_top reads).
-  Patch P;
-  P.xy_min = Vec2::Constant(1e300), P.xy_max = Vec2::Constant(-1e300);
-  P.z_min = 1e300, P.z_max = -1e300;
-  for (int i : patches) {
-    const Patch& q = a.patches[static_cast<std::size_t>(i)];
-    P.faces.insert(P.faces.end(), q.faces.begin(), q.faces.end());
-    P.xy_min = P.xy_min.cwiseMin(q.xy_min), P.xy_max = P.xy_max.cwiseMax(q.xy_max);
-    P.z_min = std::min(P.z_min, q.z_min), P.z_max = std::max(P.z_max, q.z_max);
-  }
+  // The patches as one, with the printable facets beside them (shell_top): their facets, box
+  // and height range (what faceted_top reads).
+  const Patch P = shell_top(mesh, a, patches);
   if (P.faces.empty()) {
     s.refused = "no patch to follow";
     return s;

@@ -149,6 +149,26 @@ TEST(ShellPlan, TakesFewerLayersOverAThinWall) {
   EXPECT_GE(s.bottom(20, 6) - 6.25, 0.23 - 1e-6);
 }
 
+// A cone's tip: the facets round its apex touch a curvature jump (the apex holds all of the
+// cone's angle deficit), so no patch takes them and no stack could follow them, but the shell
+// follows the facets themselves: its top H runs up to the apex, and the shell prints there.
+// (Before, H over the tip carried the patch's rim inward, 0.5 mm under the apex, and the core
+// printed the tip planar because the part stood above H there.)
+TEST(ShellPlan, FollowsFacetsThatTouchACurvatureJump) {
+  // Top 12 − 0.36·r about (20, 20) (20° slopes), the apex on a grid vertex.
+  const TriangleMesh cone = test::height_field_solid(
+      [](double x, double y) { return 12 - 0.36 * std::hypot(x - 20, y - 20); }, 0, 40, 0, 40, 40,
+      40);
+  const Analysis a = *analyze(cone, {}, {});
+  ASSERT_GT(a.discontinuous_faces, 0u);
+  const layers::ShellPlan s = plan(cone);
+  ASSERT_TRUE(s.refused.empty()) << s.refused;
+  EXPECT_NEAR(s.top.height(20, 20), 12.0, 1e-6);
+  EXPECT_NEAR(s.top.height(20.5, 20), 12 - 0.36 * 0.5, 1e-6);
+  EXPECT_TRUE(s.in_region(20, 20));
+  EXPECT_TRUE(s.left_out.empty()) << s.left_out;
+}
+
 // The CurviSlicer ankle base: its heel's curved top is ringed by a rim standing above it, so a
 // shell over both curved patches would follow the rim up in bands over 92 % of the heel (printed
 // as 402 layers and 1h33m against the planar 85 and 32m): refused. The rim's own tilted top
