@@ -82,7 +82,7 @@ Under under_shell(const TriangleMesh& mesh, const std::vector<char>& in_patch, c
 // jump (in no patch: a NURBS fit cannot follow them) and those of patches too small to fit. A
 // shell follows the facets themselves (H), so neither reason keeps them out of it: Benchy's
 // hull and deck, where 13 956 of its 22 254 printable facets touch a curvature jump, went from
-// 50 % of the curved top within 0.03 mm to 81 %. Flat patches stay out (the core lands on
+// 50 % of the curved top within 0.03 mm to 82 %. Flat patches stay out (the core lands on
 // them), and so do facets apart from the patches (the Voron ornament's, round its cap).
 Patch shell_top(const TriangleMesh& mesh, const Analysis& a, const std::vector<int>& patches) {
   Patch P;
