@@ -248,14 +248,11 @@ Expected<std::vector<SurfaceFit>> fit_for_plan(const TriangleMesh& mesh, const A
   if (lazy) linear.free_weights = false, linear.nonlinear = NonlinearSolver::none;
   std::vector<int> fitted_ids;
   auto fits = fit_patches(mesh, analysis, linear, refused, &fitted_ids, ctx);
-  if (fits && lazy) {
-    if (auto e = refine_moving(mesh, analysis, fit, params, ids, early, *fits, ctx)) {
-      beside.wait();
-      return *e;
-    }
-  }
+  std::optional<Error> refined;
+  if (fits && lazy) refined = refine_moving(mesh, analysis, fit, params, ids, early, *fits, ctx);
   beside.wait();
   if (!fits) return fits.error();
+  if (refined) return *refined;
   // All the patches in order, the rectangle unfitted for each refused one.
   for (std::size_t k = 0, f = 0; k < ids.size(); ++k) {
     if (early[k].result.needs_fit) out[k] = std::move((*fits)[f++]);

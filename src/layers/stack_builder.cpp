@@ -500,11 +500,7 @@ StackResult finish_stack(StackStart s, const TriangleMesh& mesh, const Patch& pa
   if (!ok(f) || !(st.cost_after <= st.cost_before)) {
     // The optimiser traded a limit for cost (or did not get there): keep the paper's even
     // interpolation, which meets the limits by the choice of c and N.
-    Eigen::MatrixXd even(N + 1, nc);
-    for (int i = 0; i <= N; ++i)
-      for (int j = 0; j < nc; ++j)
-        even(i, j) = (1 - static_cast<double>(i) / N) * top.surface.points[j].z() +
-                     static_cast<double>(i) / N * st.c;
+    const Eigen::MatrixXd even = starting_stack(top, N, st.c, 1.0);
     const Figures fe = measure(grid, even, p, H, dH, st.c);
     if (ok(fe)) {
       best = even, f = fe;
