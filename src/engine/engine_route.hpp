@@ -23,7 +23,8 @@ struct EngineRoute {
   const LayerParams& layers;
   const MapBackParams& map_back;
   /// PrusaSlicer started before the mesh existed (start_engine_early): the first plain run of
-  /// a mesh where it expects one takes it. Null: each run starts its own.
+  /// a mesh where it expects one takes it, a shell's two runs stop it. Null: each run starts
+  /// its own.
   EarlyEngine* early = nullptr;
 };
 

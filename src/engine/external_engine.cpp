@@ -419,6 +419,17 @@ EarlyEnginePtr start_engine_early(const EngineParams& e, const PrintConfig& c,
   return early;
 }
 
+void stop_early_engine(EarlyEngine* early) {
+  if (!early || early->taken.exchange(true)) return;
+  Launch& l = early->launch;
+  if (l.pid > 0 && !l.reaped) {
+    ::kill(-l.pid, SIGKILL);  // blocked opening its input, or still loading
+    waitpid(l.pid, &l.status, 0);
+    l.reaped = true;
+  }
+  if (l.slot) l.slot->store(0), l.slot = nullptr;
+}
+
 Expected<std::string> run_engine(const EngineParams& e, const TriangleMesh& mesh,
                                  const PrintConfig& c, const Context& ctx, const EngineRun& run,
                                  EarlyEngine* early) {

@@ -58,6 +58,10 @@ using EarlyEnginePtr = std::unique_ptr<EarlyEngine, EarlyEngineDeleter>;
 EarlyEnginePtr start_engine_early(const EngineParams& e, const PrintConfig& c,
                                   const TriangleMesh& mesh);
 
+/// Stops an early engine no run will take (a shell's two runs start their own): loading, it
+/// takes a core from them. Later runs start their own. Null: nothing to do.
+void stop_early_engine(EarlyEngine* early);
+
 /// Inputs: the engine, the mesh to slice (lowest point on the bed; its XY box centre stays
 /// where it is), the print settings it must agree with (layer heights), what this run asks.
 /// Output: the G-code text the engine wrote. Runs the engine in a temporary folder (removed

@@ -159,6 +159,7 @@ Expected<EngineShell> shell_with_engine(const TriangleMesh& mesh, const layers::
   // The two runs side by side: the engine's own run is partly serial (on the wing the core's
   // took 0.40 s, the shell's 0.21, one after the other). A thread of its own, not a TBB task:
   // it mostly waits for the engine, and must not hold a worker the stages below would use.
+  stop_early_engine(job.early);
   Context quiet;
   quiet.cancel_flag = ctx.cancel_flag;
   ctx.progress("engine", 0);

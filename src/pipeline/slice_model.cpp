@@ -244,7 +244,7 @@ Expected<std::optional<SliceResult>> try_shell(const TriangleMesh& mesh, const S
                                                const std::vector<layers::ShellPlan>& shells,
                                                const std::string& why_shell, SliceResult& planar,
                                                const std::function<void()>& spent,
-                                               const Context& ctx,
+                                               EarlyEngine* early, const Context& ctx,
                                                const LayerPlan* stacks = nullptr) {
   const std::vector<int> patches = shell_patches(shells);
   if (patches.empty()) return std::optional<SliceResult>{};
@@ -266,7 +266,7 @@ Expected<std::optional<SliceResult>> try_shell(const TriangleMesh& mesh, const S
     return std::optional<SliceResult>{};
   }
   SliceResult r;
-  const EngineRoute route{job.engine, job.print, job.layers, job.map_back};
+  const EngineRoute route{job.engine, job.print, job.layers, job.map_back, early};
   auto printed = shell_with(mesh, shells, route, ctx, stacks ? stacks->field.get() : nullptr);
   if (!printed && printed.error().status == Status::unsupported) {
     planar.notices.push_back(refused(printed.error().message));
@@ -322,17 +322,17 @@ Expected<std::optional<SliceResult>> try_shells(const TriangleMesh& mesh, const 
                                                 std::vector<layers::ShellPlan> shells,
                                                 const std::function<std::string(double)>& why,
                                                 double min_area, SliceResult& planar,
-                                                const Context& ctx) {
+                                                EarlyEngine* early, const Context& ctx) {
   auto spent = [&] {
     for (layers::ShellPlan& s : shells) drop_rasters(s);
   };
-  auto printed =
-      try_shell(mesh, job, shells, why(area_of(a, shell_patches(shells))), planar, spent, ctx);
+  auto printed = try_shell(mesh, job, shells, why(area_of(a, shell_patches(shells))), planar, spent,
+                           early, ctx);
   if (!printed || *printed || shells.size() == 1) return printed;
   const double first = area_of(a, shells.front().patches);
   if (!(first > min_area)) return printed;
   shells.assign(1, layers::choose_shell(mesh, a, job.layers));
-  return try_shell(mesh, job, shells, why(first), planar, spent, ctx);
+  return try_shell(mesh, job, shells, why(first), planar, spent, early, ctx);
 }
 
 // A part whose stacks follow only a little of its curved top (the CurviSlicer car: 172 mm² of
@@ -345,7 +345,8 @@ Expected<std::optional<SliceResult>> try_shells(const TriangleMesh& mesh, const 
 // its stacks planned but not sliced; none returned: the caller slices them).
 Expected<std::optional<SliceResult>> shell_over_stacks(const TriangleMesh& mesh,
                                                        const SliceJob& job, const Analysis& a,
-                                                       SliceResult& stacked, const Context& ctx) {
+                                                       SliceResult& stacked, EarlyEngine* early,
+                                                       const Context& ctx) {
   ctx.progress("shell", 0);
   std::vector<layers::ShellPlan> shells = shells_for(mesh, a, job);
   const double stacks = area_of(a, stacked_patches(stacked.plan));
@@ -357,7 +358,7 @@ Expected<std::optional<SliceResult>> shell_over_stacks(const TriangleMesh& mesh,
                   area, stacks);
     return std::string(buf);
   };
-  return try_shells(mesh, job, a, std::move(shells), why, 2 * stacks, stacked, ctx);
+  return try_shells(mesh, job, a, std::move(shells), why, 2 * stacks, stacked, early, ctx);
 }
 
 // Where a shell cuts the core inside a stack's band (none: nowhere). Core layer k is cut
@@ -447,7 +448,7 @@ Expected<std::optional<SliceResult>> shells_beside_stacks(const TriangleMesh& me
                           (plan->stacks.size() == 1 ? " curved stack" : " curved stacks") +
                           " beside it";
   auto both = try_shell(
-      mesh, job, shells, why, stacked, [] {}, ctx, &*plan);
+      mesh, job, shells, why, stacked, [] {}, nullptr, ctx, &*plan);
   if (!both) return failed(both.error());
   return both;
 }
@@ -517,7 +518,7 @@ Expected<SliceResult> slice_rounds(const TriangleMesh& mesh, const SliceJob& job
       // Stacks that cover little: a shell over the largest patch first, before they are sliced.
       over_stacks_tried = true;
       r->notices.insert(r->notices.begin(), dropped.begin(), dropped.end());
-      auto shell = shell_over_stacks(mesh, job, pre.analysis, *r, ctx);
+      auto shell = shell_over_stacks(mesh, job, pre.analysis, *r, pre.engine.get(), ctx);
       if (!shell) return shell.error();
       if (*shell) return done(std::move(**shell));
       // The stacks, then; and why the shell did not print, if it got as far as the gate (kept
@@ -539,7 +540,7 @@ Expected<SliceResult> slice_rounds(const TriangleMesh& mesh, const SliceJob& job
             return std::string(stacks_broke ? "its stacks broke a limit in their final paths"
                                             : "no stack over a plane fits it");
           },
-          0, *r, ctx);
+          0, *r, pre.engine.get(), ctx);
       if (!shell) return shell.error();
       if (*shell) return done(std::move(**shell));
       const std::vector<Notice> notices = std::move(r->notices);
