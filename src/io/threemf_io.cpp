@@ -1,6 +1,5 @@
-// 3MF reading and writing through lib3mf 1.8's C interface (Debian's lib3mf-dev).
-#include <Model/COM/NMR_DLLInterfaces.h>
-
+// 3MF reading and writing through lib3mf 1.8's C interface (Debian's lib3mf-dev), loaded when
+// first needed (lib3mf_api.hpp).
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cstdint>
@@ -14,6 +13,7 @@
 
 #include "core/atomic_file.hpp"
 #include "core/file_bytes.hpp"
+#include "io/lib3mf_api.hpp"
 #include "io/readers.hpp"
 #include "io/threemf_prescan.hpp"
 #include "io/zip_package.hpp"
@@ -30,14 +30,14 @@ struct Handle {
   Handle(const Handle&) = delete;
   Handle& operator=(const Handle&) = delete;
   ~Handle() {
-    if (p) NMR::lib3mf_release(p);
+    if (p) lib3mf().release(p);
   }
 };
 
 std::string last_error(NMR::PLib3MFBase* obj) {
   DWORD code = 0;
   LPCSTR msg = nullptr;
-  if (obj && NMR::lib3mf_getlasterror(obj, &code, &msg) == 0 && msg && *msg) return msg;
+  if (obj && lib3mf().getlasterror(obj, &code, &msg) == 0 && msg && *msg) return msg;
   return "lib3mf error";
 }
 
@@ -59,25 +59,24 @@ bool count_triangles(NMR::PLib3MFModelObjectResource* obj, int depth,
     return false;
   }
   DWORD id = 0;
-  const bool has_id = NMR::lib3mf_resource_getresourceid(obj, &id) == 0;
+  const bool has_id = lib3mf().resource_getresourceid(obj, &id) == 0;
   if (has_id)
     if (auto it = memo.find(id); it != memo.end()) return *count = it->second, true;
   BOOL is_mesh = false, is_comp = false;
-  NMR::lib3mf_object_ismeshobject(obj, &is_mesh);
-  NMR::lib3mf_object_iscomponentsobject(obj, &is_comp);
+  lib3mf().object_ismeshobject(obj, &is_mesh);
+  lib3mf().object_iscomponentsobject(obj, &is_comp);
   double total = 0;
   if (is_mesh) {
     DWORD nt = 0;
-    if (NMR::lib3mf_meshobject_gettrianglecount(obj, &nt) != 0)
-      return *err = last_error(obj), false;
+    if (lib3mf().meshobject_gettrianglecount(obj, &nt) != 0) return *err = last_error(obj), false;
     total = nt;
   } else if (is_comp) {
     DWORD n = 0;
-    NMR::lib3mf_componentsobject_getcomponentcount(obj, &n);
+    lib3mf().componentsobject_getcomponentcount(obj, &n);
     for (DWORD i = 0; i < n; ++i) {
       Handle comp, child;
-      if (NMR::lib3mf_componentsobject_getcomponent(obj, i, &comp.p) != 0 ||
-          NMR::lib3mf_component_getobjectresource(comp.p, &child.p) != 0)
+      if (lib3mf().componentsobject_getcomponent(obj, i, &comp.p) != 0 ||
+          lib3mf().component_getobjectresource(comp.p, &child.p) != 0)
         return *err = last_error(obj), false;
       double c = 0;
       if (!count_triangles(child.p, depth + 1, memo, &c, err)) return false;
@@ -115,19 +114,19 @@ bool append_object(NMR::PLib3MFModelObjectResource* obj, const Affine& xf, Trian
     return false;
   }
   BOOL is_mesh = false, is_comp = false;
-  NMR::lib3mf_object_ismeshobject(obj, &is_mesh);
-  NMR::lib3mf_object_iscomponentsobject(obj, &is_comp);
+  lib3mf().object_ismeshobject(obj, &is_mesh);
+  lib3mf().object_iscomponentsobject(obj, &is_comp);
   if (is_mesh) {
     DWORD nv = 0, nt = 0;
-    if (NMR::lib3mf_meshobject_getvertexcount(obj, &nv) != 0 ||
-        NMR::lib3mf_meshobject_gettrianglecount(obj, &nt) != 0) {
+    if (lib3mf().meshobject_getvertexcount(obj, &nv) != 0 ||
+        lib3mf().meshobject_gettrianglecount(obj, &nt) != 0) {
       *err = last_error(obj);
       return false;
     }
     std::vector<NMR::MODELMESHVERTEX> verts(nv);
     std::vector<NMR::MODELMESHTRIANGLE> tris(nt);
-    if ((nv && NMR::lib3mf_meshobject_getvertices(obj, verts.data(), nv, nullptr) != 0) ||
-        (nt && NMR::lib3mf_meshobject_gettriangleindices(obj, tris.data(), nt, nullptr) != 0)) {
+    if ((nv && lib3mf().meshobject_getvertices(obj, verts.data(), nv, nullptr) != 0) ||
+        (nt && lib3mf().meshobject_gettriangleindices(obj, tris.data(), nt, nullptr) != 0)) {
       *err = last_error(obj);
       return false;
     }
@@ -154,20 +153,20 @@ bool append_object(NMR::PLib3MFModelObjectResource* obj, const Affine& xf, Trian
   }
   if (is_comp) {
     DWORD n = 0;
-    NMR::lib3mf_componentsobject_getcomponentcount(obj, &n);
+    lib3mf().componentsobject_getcomponentcount(obj, &n);
     for (DWORD i = 0; i < n; ++i) {
       Handle comp, child;
-      if (NMR::lib3mf_componentsobject_getcomponent(obj, i, &comp.p) != 0 ||
-          NMR::lib3mf_component_getobjectresource(comp.p, &child.p) != 0) {
+      if (lib3mf().componentsobject_getcomponent(obj, i, &comp.p) != 0 ||
+          lib3mf().component_getobjectresource(comp.p, &child.p) != 0) {
         *err = last_error(obj);
         return false;
       }
       Affine cxf = Affine::Identity();
       BOOL has = false;
-      NMR::lib3mf_component_hastransform(comp.p, &has);
+      lib3mf().component_hastransform(comp.p, &has);
       if (has) {
         NMR::MODELTRANSFORM m;
-        NMR::lib3mf_component_gettransform(comp.p, &m);
+        lib3mf().component_gettransform(comp.p, &m);
         cxf = to_affine(m);
         if (!cxf.matrix().allFinite()) return *err = "a component's transform is not finite", false;
       }
@@ -180,9 +179,9 @@ bool append_object(NMR::PLib3MFModelObjectResource* obj, const Affine& xf, Trian
 // The object's name as the 3MF gives it ("" when none).
 std::string object_name(NMR::PLib3MFModelObjectResource* obj) {
   ULONG need = 0;
-  if (NMR::lib3mf_object_getnameutf8(obj, nullptr, 0, &need) != 0 || need == 0) return "";
+  if (lib3mf().object_getnameutf8(obj, nullptr, 0, &need) != 0 || need == 0) return "";
   std::string s(need + 1, '\0');
-  if (NMR::lib3mf_object_getnameutf8(obj, s.data(), static_cast<ULONG>(s.size()), &need) != 0)
+  if (lib3mf().object_getnameutf8(obj, s.data(), static_cast<ULONG>(s.size()), &need) != 0)
     return "";
   s.resize(std::min<std::size_t>(std::strlen(s.c_str()), 200));
   return s;
@@ -284,7 +283,7 @@ class ItemNames {
  private:
   static DWORD id_of(NMR::PLib3MFModelObjectResource* obj) {
     DWORD id = 0;
-    NMR::lib3mf_resource_getresourceid(obj, &id);
+    lib3mf().resource_getresourceid(obj, &id);
     return id;
   }
   // The config object with the greatest first id at or below this one, if it reaches it.
@@ -332,14 +331,14 @@ void drop_volumes(TriangleMesh& m, std::size_t first_vertex, std::size_t first_f
 Expected<TriangleMesh> parse_package(std::string_view data, std::size_t max_triangles,
                                      PlateObjects* objects) {
   Handle model, reader;
-  if (NMR::lib3mf_createmodel(&model.p) != 0 ||
-      NMR::lib3mf_model_queryreader(model.p, "3mf", &reader.p) != 0)
+  if (lib3mf().createmodel(&model.p) != 0 ||
+      lib3mf().model_queryreader(model.p, "3mf", &reader.p) != 0)
     return Error{Status::internal_error, "cannot create a lib3mf reader"};
   std::vector<BYTE> buf(data.begin(), data.end());
-  if (NMR::lib3mf_reader_readfrombuffer(reader.p, buf.data(), buf.size()) != 0)
+  if (lib3mf().reader_readfrombuffer(reader.p, buf.data(), buf.size()) != 0)
     return Error{Status::parse_error, "not a valid 3MF file (" + last_error(reader.p) + ")"};
   Handle items;
-  if (NMR::lib3mf_model_getbuilditems(model.p, &items.p) != 0)
+  if (lib3mf().model_getbuilditems(model.p, &items.p) != 0)
     return Error{Status::parse_error, "3MF build has no items"};
   TriangleMesh mesh;
   BOOL has_next = false;
@@ -347,10 +346,10 @@ Expected<TriangleMesh> parse_package(std::string_view data, std::size_t max_tria
   // Pass 1: count; pass 2 (a fresh iterator): build.
   std::unordered_map<DWORD, double> memo;
   double triangles = 0;
-  while (NMR::lib3mf_builditemiterator_movenext(items.p, &has_next) == 0 && has_next) {
+  while (lib3mf().builditemiterator_movenext(items.p, &has_next) == 0 && has_next) {
     Handle item, obj;
-    if (NMR::lib3mf_builditemiterator_getcurrent(items.p, &item.p) != 0 ||
-        NMR::lib3mf_builditem_getobjectresource(item.p, &obj.p) != 0)
+    if (lib3mf().builditemiterator_getcurrent(items.p, &item.p) != 0 ||
+        lib3mf().builditem_getobjectresource(item.p, &obj.p) != 0)
       return Error{Status::parse_error, "3MF build item: " + last_error(items.p)};
     double c = 0;
     if (!count_triangles(obj.p, 0, memo, &c, &err))
@@ -366,22 +365,22 @@ Expected<TriangleMesh> parse_package(std::string_view data, std::size_t max_tria
     }
   }
   Handle again;
-  if (NMR::lib3mf_model_getbuilditems(model.p, &again.p) != 0)
+  if (lib3mf().model_getbuilditems(model.p, &again.p) != 0)
     return Error{Status::parse_error, "3MF build has no items"};
   ItemNames names(data);
   mesh.vertices.reserve(static_cast<std::size_t>(3 * triangles));
   mesh.faces.reserve(static_cast<std::size_t>(triangles));
-  while (NMR::lib3mf_builditemiterator_movenext(again.p, &has_next) == 0 && has_next) {
+  while (lib3mf().builditemiterator_movenext(again.p, &has_next) == 0 && has_next) {
     Handle item, obj;
-    if (NMR::lib3mf_builditemiterator_getcurrent(again.p, &item.p) != 0 ||
-        NMR::lib3mf_builditem_getobjectresource(item.p, &obj.p) != 0)
+    if (lib3mf().builditemiterator_getcurrent(again.p, &item.p) != 0 ||
+        lib3mf().builditem_getobjectresource(item.p, &obj.p) != 0)
       return Error{Status::parse_error, "3MF build item: " + last_error(again.p)};
     Affine xf = Affine::Identity();
     BOOL has = false;
-    NMR::lib3mf_builditem_hasobjecttransform(item.p, &has);
+    lib3mf().builditem_hasobjecttransform(item.p, &has);
     if (has) {
       NMR::MODELTRANSFORM m;
-      NMR::lib3mf_builditem_getobjecttransform(item.p, &m);
+      lib3mf().builditem_getobjecttransform(item.p, &m);
       xf = to_affine(m);
       if (!xf.matrix().allFinite())
         return Error{Status::parse_error, "3MF build item: its transform is not finite"};
@@ -396,7 +395,7 @@ Expected<TriangleMesh> parse_package(std::string_view data, std::size_t max_tria
     }
   }
   DWORD unit = NMR::MODELUNIT_MILLIMETER;
-  NMR::lib3mf_model_getunit(model.p, &unit);
+  lib3mf().model_getunit(model.p, &unit);
   if (const double mm = unit_in_mm(unit); mm != 1.0)
     for (Vec3& v : mesh.vertices) v *= mm;
   if (mesh.faces.empty()) return Error{Status::invalid_mesh, "3MF build holds no triangles"};
@@ -425,6 +424,7 @@ Expected<TriangleMesh> parse_3mf(std::string_view data, std::size_t max_triangle
       return Error{Status::invalid_mesh, msg};
     }
   }
+  if (std::string why; !load_lib3mf(&why)) return Error{Status::io_error, why};
   PlateObjects found;
   auto r = parse_package(data, max_triangles, &found);
   if (r || r.error().message.rfind("not a valid 3MF file", 0) != 0) {
@@ -513,9 +513,11 @@ Expected<void> write_3mf(const std::filesystem::path& file, const TriangleMesh& 
                          const std::vector<PackageFile>& extra_files, const Object3mf& object) {
   std::vector<PackageFile> extra = extra_files;
   using io::Handle;
+  using io::lib3mf;
+  if (std::string why; !io::load_lib3mf(&why))
+    return Error{Status::io_error, file.string() + ": " + why};
   Handle model, obj, item, writer;
-  if (NMR::lib3mf_createmodel(&model.p) != 0 ||
-      NMR::lib3mf_model_addmeshobject(model.p, &obj.p) != 0)
+  if (lib3mf().createmodel(&model.p) != 0 || lib3mf().model_addmeshobject(model.p, &obj.p) != 0)
     return Error{Status::internal_error, file.string() + ": cannot create a 3MF model"};
   std::vector<NMR::MODELMESHVERTEX> verts;
   std::vector<NMR::MODELMESHTRIANGLE> tris;
@@ -532,37 +534,37 @@ Expected<void> write_3mf(const std::filesystem::path& file, const TriangleMesh& 
       tris.push_back(t);
     }
   }
-  if (NMR::lib3mf_meshobject_setgeometry(obj.p, verts.data(), static_cast<DWORD>(verts.size()),
-                                         tris.data(), static_cast<DWORD>(tris.size())) != 0 ||
-      NMR::lib3mf_model_addbuilditem(model.p, obj.p, nullptr, &item.p) != 0 ||
-      NMR::lib3mf_model_querywriter(model.p, "3mf", &writer.p) != 0)
+  if (lib3mf().meshobject_setgeometry(obj.p, verts.data(), static_cast<DWORD>(verts.size()),
+                                      tris.data(), static_cast<DWORD>(tris.size())) != 0 ||
+      lib3mf().model_addbuilditem(model.p, obj.p, nullptr, &item.p) != 0 ||
+      lib3mf().model_querywriter(model.p, "3mf", &writer.p) != 0)
     return Error{Status::internal_error, file.string() + ": " + io::last_error(model.p)};
-  if (!object.name.empty() && NMR::lib3mf_object_setnameutf8(obj.p, object.name.c_str()) != 0)
+  if (!object.name.empty() && lib3mf().object_setnameutf8(obj.p, object.name.c_str()) != 0)
     return Error{Status::internal_error, file.string() + ": " + io::last_error(model.p)};
   if (!object.name.empty() || !object.settings.empty() || !object.support_blockers.empty()) {
     DWORD id = 0;
-    NMR::lib3mf_resource_getresourceid(obj.p, &id);
+    lib3mf().resource_getresourceid(obj.p, &id);
     extra.push_back(
         {"/Metadata/Slic3r_PE_model.config", slic3r_model_config(id, mesh.faces.size(), object)});
   }
   if (!extra.empty()) {
-    NMR::lib3mf_model_addcustomcontenttypeutf8(model.p, "txt", "text/plain");
-    NMR::lib3mf_model_addcustomcontenttypeutf8(model.p, "config", "text/xml");
-    NMR::lib3mf_model_addcustomcontenttypeutf8(model.p, "json", "application/json");
+    lib3mf().model_addcustomcontenttypeutf8(model.p, "txt", "text/plain");
+    lib3mf().model_addcustomcontenttypeutf8(model.p, "config", "text/xml");
+    lib3mf().model_addcustomcontenttypeutf8(model.p, "json", "application/json");
   }
   for (const PackageFile& f : extra) {
     Handle att;
     std::string path = f.path, type = "http://schemas.nonplanar.org/3mf/attachment";
     std::vector<BYTE> bytes(f.content.begin(), f.content.end());
-    if (NMR::lib3mf_model_addattachmentutf8(model.p, path.data(), type.data(), &att.p) != 0 ||
-        NMR::lib3mf_attachment_readfrombuffer(att.p, bytes.data(), bytes.size()) != 0)
+    if (lib3mf().model_addattachmentutf8(model.p, path.data(), type.data(), &att.p) != 0 ||
+        lib3mf().attachment_readfrombuffer(att.p, bytes.data(), bytes.size()) != 0)
       return Error{Status::internal_error, file.string() + ": " + io::last_error(model.p)};
   }
   ULONG64 size = 0;
-  if (NMR::lib3mf_writer_getstreamsize(writer.p, &size) != 0)
+  if (lib3mf().writer_getstreamsize(writer.p, &size) != 0)
     return Error{Status::internal_error, file.string() + ": " + io::last_error(writer.p)};
   std::vector<BYTE> buf(size);
-  if (NMR::lib3mf_writer_writetobuffer(writer.p, buf.data(), size) != 0)
+  if (lib3mf().writer_writetobuffer(writer.p, buf.data(), size) != 0)
     return Error{Status::internal_error, file.string() + ": " + io::last_error(writer.p)};
   return write_file_atomically(file, [&](std::ostream& out) {
     out.write(reinterpret_cast<const char*>(buf.data()), static_cast<std::streamsize>(buf.size()));

@@ -2,6 +2,8 @@
 // glibc's huge-page heap, and the slicers the program runs get the user's environment.
 #include <gtest/gtest.h>
 
+#include <sys/wait.h>
+
 #include <filesystem>
 #include <string>
 
@@ -46,6 +48,25 @@ TEST(Launcher, WithoutTheProgramBesideItSaysWhatIsMissing) {
   const std::string err = test::read_bytes(dir / "err");
   EXPECT_NE(err.find((dir / "nonplanar-core").string()), std::string::npos) << err;
   EXPECT_EQ(test::count_lines(err), 1u) << err;
+}
+
+// lib3mf (and the zip and crypto libraries under it: 5 ms of every run's start) is loaded
+// when a 3MF is read, not by a run that reads an STL.
+TEST(Launcher, Lib3mfIsLoadedOnlyWhenA3mfIsRead) {
+  const fs::path dir = test::temp_dir("launcher_lib3mf");
+  const TriangleMesh box = test::box({0, 0, 0}, {10, 10, 1});
+  ASSERT_TRUE(write_stl(dir / "b.stl", box));
+  ASSERT_TRUE(write_3mf(dir / "b.3mf", box));
+  auto loads = [&](const std::string& model) {
+    const fs::path err = dir / "err";
+    const std::string cmd = "LD_DEBUG=files " + std::string(NONPLANAR_CLI) + " analyze " +
+                            (dir / model).string() + " >/dev/null 2>" + err.string();
+    const int status = std::system(cmd.c_str());
+    EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << test::read_bytes(err);
+    return test::read_bytes(err).find("lib3MF") != std::string::npos;
+  };
+  EXPECT_FALSE(loads("b.stl"));
+  EXPECT_TRUE(loads("b.3mf"));
 }
 
 }  // namespace
