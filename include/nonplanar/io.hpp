@@ -3,6 +3,7 @@
 
 #include <filesystem>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "nonplanar/context.hpp"
@@ -48,12 +49,16 @@ Expected<LoadedMesh> load_mesh(const std::filesystem::path& file, const LoadPara
 /// Binary STL writer (used by tests, benchmarks and later stages). Atomic.
 Expected<void> write_stl(const std::filesystem::path& file, const TriangleMesh& mesh);
 
-/// The mesh as Wavefront OBJ text, as a binary STL of it would reach a slicer: coordinates
-/// rounded to float (written as that float's exact value read as a double), vertices
-/// shared where their floats are equal (in order of first use by the faces), faces whose
-/// corners collapse to one point or an edge left out (counted in *collapsed if given). For a
-/// reader that cannot seek (a pipe: PrusaSlicer reads an STL with fseek, an OBJ front to back).
-std::string obj_text(const TriangleMesh& mesh, std::size_t* collapsed = nullptr);
+/// The mesh as one object of AMF XML (uncompressed), as a binary STL of it would reach a
+/// slicer: coordinates rounded to float (written as that float's exact value read as a
+/// double), vertices shared where their floats are equal (in order of first use by the faces,
+/// indices from 0), faces whose corners collapse to one point or an edge left out (counted in
+/// *collapsed if given). `metadata`: the object's (type, value) pairs, written as given (XML
+/// text: no '<' or '&' in them), e.g. ("slic3r.layer_height_profile", "z;h;z;h;…"). For a
+/// reader that cannot seek (a pipe: PrusaSlicer reads an STL or 3MF with fseek, an .amf.xml
+/// front to back) that must also get a layer-height profile, which OBJ cannot carry.
+std::string amf_text(const TriangleMesh& mesh, std::size_t* collapsed = nullptr,
+                     const std::vector<std::pair<std::string, std::string>>& metadata = {});
 
 /// A file stored beside the model in a 3MF package: its path in the package ("/Metadata/…")
 /// and its bytes.

@@ -16,6 +16,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <sstream>
 #include <thread>
 
@@ -184,6 +185,7 @@ namespace {
 struct Launch {
   TempDir dir;
   fs::path input, out, log;
+  fs::path settings;  ///< started early: the pipe it reads the run's layer heights from
   pid_t pid = 0;
   std::atomic<pid_t>* slot = nullptr;
   bool reaped = false;
@@ -207,7 +209,9 @@ struct Launch {
 
 // The engine's command line for `run` of a mesh whose XY box is centred at `centre`, read
 // from l.input (first_layer: the first layer's height, mm); PrusaSlicer's also writes
-// forced.ini into the folder.
+// forced.ini into the folder. With l.settings, PrusaSlicer reads the layer heights from that
+// file after forced.ini (run_settings: a pipe written when the run is known) instead of the
+// command line.
 Expected<std::vector<std::string>> engine_args(const EngineParams& e, const PrintConfig& c,
                                                const EngineRun& run, const Launch& l,
                                                const Vec2& centre, double first_layer,
@@ -251,10 +255,13 @@ Expected<std::vector<std::string>> engine_args(const EngineParams& e, const Prin
   args.push_back("--export-gcode");
   if (!e.config.empty()) args.insert(args.end(), {"--load", e.config});
   const double h = run.slab_layer_height > 0 ? run.slab_layer_height : c.slice.layer_height;
-  args.insert(args.end(),
-              {"--load", forced.string(), "--layer-height", num(h), "--first-layer-height",
-               num(first_layer), "--retract-lift", "0", "--no-spiral-vase", "--center",
-               num(centre.x()) + "," + num(centre.y())});
+  args.insert(args.end(), {"--load", forced.string()});
+  if (!l.settings.empty())
+    args.insert(args.end(), {"--load", l.settings.string()});
+  else
+    args.insert(args.end(), {"--layer-height", num(h), "--first-layer-height", num(first_layer)});
+  args.insert(args.end(), {"--retract-lift", "0", "--no-spiral-vase", "--center",
+                           num(centre.x()) + "," + num(centre.y())});
   if (e.config.empty()) {
     char bed[160];
     std::snprintf(bed, sizeof bed, "%gx%g,%gx%g,%gx%g,%gx%g", c.bed_min.x(), c.bed_min.y(),
@@ -306,10 +313,38 @@ bool exited(Launch& l) {
   return l.reaped;
 }
 
-// Writes `text` into the pipe the engine reads its mesh from, once the engine opens it (after
-// loading its libraries and profile: the time this saves). An engine that stopped before
-// reading it all is left to finish() to report. A SIGPIPE the writes raise is dropped.
-Expected<void> feed(Launch& l, const std::string& text, const Context& ctx) {
+// The layer heights of a run whose engine reads them from l.settings (the --layer-height and
+// --first-layer-height engine_args gives a run started late).
+std::string run_settings(const PrintConfig& c, const EngineRun& run, double first_layer) {
+  const double h = run.slab_layer_height > 0 ? run.slab_layer_height : c.slice.layer_height;
+  return "layer_height = " + num(h) + "\nfirst_layer_height = " + num(first_layer) + "\n";
+}
+
+// Writes a pipe's text fully into it once opened (false: the engine stopped reading: it
+// reports why).
+Expected<bool> write_pipe(int fd, const std::string& text, const Context& ctx) {
+  std::size_t done = 0;
+  while (done < text.size()) {
+    const ssize_t n =
+        ::write(fd, text.data() + done, std::min<std::size_t>(text.size() - done, 1 << 16));
+    if (n > 0) {
+      done += static_cast<std::size_t>(n);
+    } else if (n < 0 && errno == EAGAIN) {
+      pollfd p{fd, POLLOUT, 0};
+      ::poll(&p, 1, 20);
+      if (ctx.cancelled()) return Error{Status::cancelled, "cancelled"};
+    } else if (!(n < 0 && errno == EINTR)) {
+      return false;  // EPIPE: it stopped reading
+    }
+  }
+  return true;
+}
+
+// Writes each (pipe, text) into its pipe as the engine opens it (after loading its libraries
+// and profile: the time this saves), in whichever order it opens them. An engine that stopped
+// before reading them all is left to finish() to report. A SIGPIPE the writes raise is dropped.
+Expected<void> feed(Launch& l, std::vector<std::pair<fs::path, std::string>> pipes,
+                    const Context& ctx) {
   sigset_t pipe_signal, old;
   sigemptyset(&pipe_signal);
   sigaddset(&pipe_signal, SIGPIPE);
@@ -323,29 +358,25 @@ Expected<void> feed(Launch& l, const std::string& text, const Context& ctx) {
       pthread_sigmask(SIG_SETMASK, &old, nullptr);
     }
   } restore{pipe_signal, old};
-  int fd = -1;
-  while ((fd = ::open(l.input.c_str(), O_WRONLY | O_NONBLOCK | O_CLOEXEC)) < 0) {
-    if (errno != ENXIO && errno != EINTR)
-      return Error{Status::io_error, "engine: cannot write its input " + l.input.string()};
+  while (!pipes.empty()) {
+    bool opened = false;
+    for (auto it = pipes.begin(); it != pipes.end() && !opened; ++it) {
+      const int fd = ::open(it->first.c_str(), O_WRONLY | O_NONBLOCK | O_CLOEXEC);
+      if (fd < 0 && errno != ENXIO && errno != EINTR)
+        return Error{Status::io_error, "engine: cannot write its input " + it->first.string()};
+      if (fd < 0) continue;
+      opened = true;
+      auto wrote = write_pipe(fd, it->second, ctx);
+      ::close(fd);
+      if (!wrote) return wrote.error();
+      if (!*wrote) return {};
+      pipes.erase(it);
+    }
+    if (opened) continue;
     if (exited(l)) return {};
     if (ctx.cancelled()) return Error{Status::cancelled, "cancelled"};
     std::this_thread::sleep_for(std::chrono::milliseconds(1));
   }
-  std::size_t done = 0;
-  while (done < text.size()) {
-    const ssize_t n =
-        ::write(fd, text.data() + done, std::min<std::size_t>(text.size() - done, 1 << 16));
-    if (n > 0) {
-      done += static_cast<std::size_t>(n);
-    } else if (n < 0 && errno == EAGAIN) {
-      pollfd p{fd, POLLOUT, 0};
-      ::poll(&p, 1, 20);
-      if (ctx.cancelled()) return ::close(fd), Error{Status::cancelled, "cancelled"};
-    } else if (!(n < 0 && errno == EINTR)) {
-      break;  // EPIPE: it stopped reading
-    }
-  }
-  ::close(fd);
   return {};
 }
 
@@ -390,7 +421,7 @@ Expected<std::string> finish(Launch& l, const EngineParams& e, const PrintConfig
 }  // namespace
 
 struct EarlyEngine {
-  Launch launch{"normalized.obj"};
+  Launch launch{"part.amf.xml"};
   Vec2 centre;
   std::atomic<bool> taken{false};
 };
@@ -403,7 +434,7 @@ EarlyEnginePtr start_engine_early(const EngineParams& e, const PrintConfig& c,
                                   const TriangleMesh& mesh) {
   if (e.engine != Engine::prusaslicer) return nullptr;
   // PrusaSlicer repairs an STL as it reads it (edges matched across small gaps, holes filled)
-  // and an OBJ not: the same G-code from both needs a mesh with nothing to repair (the
+  // and an AMF not: the same G-code from both needs a mesh with nothing to repair (the
   // CurviSlicer car, open in places, came out 7 facets apart).
   const MeshTopology t = build_topology(mesh);
   if (t.open_edges || t.non_manifold_edges || t.inconsistent_edges) return nullptr;
@@ -411,7 +442,10 @@ EarlyEnginePtr start_engine_early(const EngineParams& e, const PrintConfig& c,
   const Vec2 centre = 0.5 * (box.min + box.max).head<2>();
   EarlyEnginePtr early(new EarlyEngine);
   Launch& l = early->launch;
-  if (l.dir.path.empty() || ::mkfifo(l.input.c_str(), 0600) != 0) return nullptr;
+  if (l.dir.path.empty()) return nullptr;
+  l.settings = l.dir.path / "run.ini";
+  if (::mkfifo(l.input.c_str(), 0600) != 0 || ::mkfifo(l.settings.c_str(), 0600) != 0)
+    return nullptr;
   auto args = engine_args(e, c, EngineRun{}, l, centre, c.slice.first_layer_height, engine_exe(e));
   if (!args || !spawn(l, std::move(*args), "PrusaSlicer")) return nullptr;
   early->centre = centre;
@@ -419,16 +453,43 @@ EarlyEnginePtr start_engine_early(const EngineParams& e, const PrintConfig& c,
   return early;
 }
 
-void stop_early_engine(EarlyEngine* early) {
-  if (!early || early->taken.exchange(true)) return;
-  Launch& l = early->launch;
-  if (l.pid > 0 && !l.reaped) {
-    ::kill(-l.pid, SIGKILL);  // blocked opening its input, or still loading
-    waitpid(l.pid, &l.status, 0);
-    l.reaped = true;
-  }
-  if (l.slot) l.slot->store(0), l.slot = nullptr;
+namespace {
+
+// The layer-height profile of a run of `mesh` (none: empty): PrusaSlicer's pairs over the
+// mesh's lowest point.
+std::string run_profile(const TriangleMesh& mesh, const PrintConfig& c, const EngineRun& run) {
+  if (run.layer_tops.empty()) return {};
+  const BoundingBox box = bounding_box(mesh);
+  std::vector<double> tops;
+  for (double z : run.layer_tops) tops.push_back(z - box.min.z());
+  return layer_height_profile(tops, c.slice.layer_height, box.max.z() - box.min.z());
 }
+
+// The run given to the engine started early: its layer heights, then the mesh as AMF (with
+// the profile, if any), as the engine opens the two pipes. Empty: it cannot take this mesh
+// (faces that collapse in float: the STL of a run started late lets PrusaSlicer repair them).
+std::optional<Expected<std::string>> run_early(EarlyEngine& early, const EngineParams& e,
+                                               const TriangleMesh& mesh, const PrintConfig& c,
+                                               const Context& ctx, const EngineRun& run,
+                                               double first_layer) {
+  std::size_t collapsed = 0;
+  std::vector<std::pair<std::string, std::string>> metadata;
+  if (std::string profile = run_profile(mesh, c, run); !profile.empty()) {
+    // The 3MF's text without its object and line end: "z;h;z;h;…".
+    profile = profile.substr(profile.find('|') + 1);
+    if (!profile.empty() && profile.back() == '\n') profile.pop_back();
+    metadata.emplace_back("slic3r.layer_height_profile", profile);
+  }
+  std::string amf = amf_text(mesh, &collapsed, metadata);
+  if (collapsed != 0) return std::nullopt;
+  Launch& l = early.launch;
+  l.waiting = false;
+  auto fed =
+      feed(l, {{l.settings, run_settings(c, run, first_layer)}, {l.input, std::move(amf)}}, ctx);
+  return fed ? finish(l, e, c, ctx) : Expected<std::string>(fed.error());
+}
+
+}  // namespace
 
 Expected<std::string> run_engine(const EngineParams& e, const TriangleMesh& mesh,
                                  const PrintConfig& c, const Context& ctx, const EngineRun& run,
@@ -437,36 +498,27 @@ Expected<std::string> run_engine(const EngineParams& e, const TriangleMesh& mesh
   const BoundingBox box = bounding_box(mesh);
   // Where the part is: the engine centres its box there.
   const Vec2 centre = 0.5 * (box.min + box.max).head<2>();
-  const bool plain = run.layer_tops.empty() && run.slab_layer_height <= 0;
-  if (early && plain && !orca && centre == early->centre && !early->taken.exchange(true)) {
-    std::size_t collapsed = 0;
-    std::string obj = obj_text(mesh, &collapsed);
-    if (collapsed == 0) {  // else an STL, which PrusaSlicer repairs as it did before
-      early->launch.waiting = false;
-      auto fed = feed(early->launch, obj, ctx);
-      auto gcode = fed ? finish(early->launch, e, c, ctx) : Expected<std::string>(fed.error());
-      // A pipe that could not be written, or a PrusaSlicer that failed (one whose reader seeks
-      // in an OBJ too, or a bad profile): run again as before, on an STL; the user gets its
-      // file, or what that run says.
-      if (gcode || gcode.error().status != Status::io_error) return gcode;
-    }
-  }
   const bool profile = !orca && !run.layer_tops.empty();
+  const double h1 = run.slab_layer_height > 0 ? run.slab_layer_height
+                    : profile                 ? run.layer_tops.front() - box.min.z()
+                                              : c.slice.first_layer_height;
+  // A plain run or one with a profile (a shell's core) takes the engine started early; a slab
+  // is centred elsewhere and changes more settings than the layers' heights.
+  if (early && !orca && run.slab_layer_height <= 0 && centre == early->centre &&
+      !early->taken.exchange(true))
+    if (auto gcode = run_early(*early, e, mesh, c, ctx, run, h1))
+      // A pipe that could not be written, or a PrusaSlicer that failed (one whose readers seek
+      // in an ini or AMF too, or a bad profile): run again as before, from files; the user
+      // gets its file, or what that run says.
+      if (*gcode || gcode->error().status != Status::io_error) return std::move(*gcode);
   Launch l(profile ? "core.3mf" : "normalized.stl");
   if (l.dir.path.empty()) return Error{Status::io_error, "engine: cannot make a temporary folder"};
   if (profile) {
-    const double top = box.max.z() - box.min.z();
-    std::vector<double> tops;
-    for (double z : run.layer_tops) tops.push_back(z - box.min.z());
-    const PackageFile f{"/Metadata/Slic3r_PE_layer_heights_profile.txt",
-                        layer_height_profile(tops, c.slice.layer_height, top)};
+    const PackageFile f{"/Metadata/Slic3r_PE_layer_heights_profile.txt", run_profile(mesh, c, run)};
     if (auto w = write_3mf(l.input, mesh, {f}); !w) return w.error();
   } else if (auto w = write_stl(l.input, mesh); !w) {
     return w.error();
   }
-  const double h1 = run.slab_layer_height > 0 ? run.slab_layer_height
-                    : profile                 ? run.layer_tops.front() - box.min.z()
-                                              : c.slice.first_layer_height;
   auto args = engine_args(e, c, run, l, centre, h1, engine_exe(e));
   if (!args) return args.error();
   if (auto s = spawn(l, std::move(*args), orca ? "OrcaSlicer" : "PrusaSlicer"); !s)

@@ -41,26 +41,24 @@ std::vector<std::string> engine_shell_settings(double first_layer);
 
 /// A PrusaSlicer run started before its mesh exists: it loads its libraries and the profile
 /// (0.13 s of its 0.38 s on the sine roof) while the pipeline plans the layers, then reads the
-/// mesh as OBJ text from a pipe (it reads an STL with a seek), as it would have read its STL.
-/// Owned by the caller; stopped (SIGKILL: it waits for its input) and its folder removed when
-/// dropped unused.
+/// run's layer heights (an ini) and the mesh (AMF text, with a layer-height profile when the
+/// run has one) from two pipes (it reads an STL or a 3MF with a seek), and writes what it
+/// writes of the STL or 3MF. Owned by the caller; stopped (SIGKILL: it waits for its input)
+/// and its folder removed when dropped unused.
 struct EarlyEngine;
 struct EarlyEngineDeleter {
   void operator()(EarlyEngine* p) const;
 };
 using EarlyEnginePtr = std::unique_ptr<EarlyEngine, EarlyEngineDeleter>;
 
-/// Starts PrusaSlicer for a plain run (EngineRun{}) of `mesh` or of a mesh made from it by
-/// moving its vertices in z only (the normalised one: its XY box centred where this one's is),
-/// with e and c as run_engine will be given them. Null for OrcaSlicer, for a mesh PrusaSlicer
-/// would repair (open, non-manifold or inconsistently wound edges: it repairs an STL and not an
-/// OBJ), or when it cannot start (run_engine then starts its own and reports what goes wrong).
+/// Starts PrusaSlicer for a run of `mesh` or of a mesh made from it by moving its vertices in
+/// z only (the normalised one, or the part itself as a shell's core: its XY box centred where
+/// this one's is), with e and c as run_engine will be given them. Null for OrcaSlicer, for a
+/// mesh PrusaSlicer would repair (open, non-manifold or inconsistently wound edges: it repairs
+/// an STL and not an AMF), or when it cannot start (run_engine then starts its own and reports
+/// what goes wrong).
 EarlyEnginePtr start_engine_early(const EngineParams& e, const PrintConfig& c,
                                   const TriangleMesh& mesh);
-
-/// Stops an early engine no run will take (a shell's two runs start their own): loading, it
-/// takes a core from them. Later runs start their own. Null: nothing to do.
-void stop_early_engine(EarlyEngine* early);
 
 /// Inputs: the engine, the mesh to slice (lowest point on the bed; its XY box centre stays
 /// where it is), the print settings it must agree with (layer heights), what this run asks.
@@ -69,8 +67,9 @@ void stop_early_engine(EarlyEngine* early);
 /// SIGKILL after 3 s). Errors: io_error (engine missing, failed: its last output line; a
 /// file without the statistics or config block a slicer writes after the last layer, i.e.
 /// truncated), cancelled. `early`: an engine start_engine_early started with the same e and c;
-/// a plain run of a mesh centred where it expects takes it (once), else it is left alone; when
-/// it fails, the run starts its own on an STL, as without it.
+/// a run that is not a slab (plain, or with layer tops) of a mesh centred where it expects
+/// takes it (once), else it is left alone; when it fails, the run starts its own from files,
+/// as without it.
 Expected<std::string> run_engine(const EngineParams& e, const TriangleMesh& mesh,
                                  const PrintConfig& c, const Context& ctx,
                                  const EngineRun& run = {}, EarlyEngine* early = nullptr);

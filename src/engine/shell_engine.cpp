@@ -107,7 +107,7 @@ Expected<ForeignGcode> core_with_engine(const TriangleMesh& mesh, const layers::
                                         const EngineRoute& job, const Context& ctx) {
   EngineRun core_run;
   core_run.layer_tops.assign(plan.core.begin() + 1, plan.core.end());
-  auto core_text = run_engine(job.engine, mesh, job.print, ctx, core_run);
+  auto core_text = run_engine(job.engine, mesh, job.print, ctx, core_run, job.early);
   if (!core_text) return core_text.error();
   return map_shell_core(*core_text, plan, job, ctx);
 }
@@ -159,7 +159,6 @@ Expected<EngineShell> shell_with_engine(const TriangleMesh& mesh, const layers::
   // The two runs side by side: the engine's own run is partly serial (on the wing the core's
   // took 0.40 s, the shell's 0.21, one after the other). A thread of its own, not a TBB task:
   // it mostly waits for the engine, and must not hold a worker the stages below would use.
-  stop_early_engine(job.early);
   Context quiet;
   quiet.cancel_flag = ctx.cancel_flag;
   ctx.progress("engine", 0);

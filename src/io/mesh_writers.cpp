@@ -48,7 +48,8 @@ struct FloatTripleHash {
 
 }  // namespace
 
-std::string obj_text(const TriangleMesh& mesh, std::size_t* collapsed) {
+std::string amf_text(const TriangleMesh& mesh, std::size_t* collapsed,
+                     const std::vector<std::pair<std::string, std::string>>& metadata) {
   if (collapsed) *collapsed = 0;
   // Keyed by the floats' bits: -0.0f and 0.0f stay two vertices, as an STL reader comparing
   // bytes keeps them.
@@ -56,9 +57,9 @@ std::string obj_text(const TriangleMesh& mesh, std::size_t* collapsed) {
   std::unordered_map<Key, std::uint32_t, FloatTripleHash> index;
   index.reserve(mesh.vertices.size());
   std::string v, f;
-  v.reserve(mesh.vertices.size() * 36);
-  f.reserve(mesh.faces.size() * 24);
-  char buf[128];
+  v.reserve(mesh.vertices.size() * 100);
+  f.reserve(mesh.faces.size() * 56);
+  char buf[160];
   auto key_of = [](const Vec3& p, float c[3]) {
     Key key;
     for (int k = 0; k < 3; ++k) {
@@ -66,6 +67,10 @@ std::string obj_text(const TriangleMesh& mesh, std::size_t* collapsed) {
       std::memcpy(&key[static_cast<std::size_t>(k)], &c[k], 4);
     }
     return key;
+  };
+  auto put = [&](char* e, const char* s) {
+    while (*s) *e++ = *s++;
+    return e;
   };
   for (const auto& face : mesh.faces) {
     float c[3][3];
@@ -77,25 +82,43 @@ std::string obj_text(const TriangleMesh& mesh, std::size_t* collapsed) {
     }
     std::uint32_t id[3];
     for (int k = 0; k < 3; ++k) {
-      const auto [it, added] = index.emplace(keys[k], static_cast<std::uint32_t>(index.size() + 1));
+      const auto [it, added] = index.emplace(keys[k], static_cast<std::uint32_t>(index.size()));
       id[k] = it->second;
       if (!added) continue;
-      char* e = buf;
-      *e++ = 'v';
       // The float's own value as a double, in the fewest digits that read back as that
       // double: a reader parsing to float or to double, then to float, gets the float.
-      for (float x : c[k])
-        *e++ = ' ', e = std::to_chars(e, buf + sizeof buf, static_cast<double>(x)).ptr;
-      *e++ = '\n';
+      const char* tags[3][2] = {{"<x>", "</x>"}, {"<y>", "</y>"}, {"<z>", "</z>"}};
+      char* e = put(buf, "<vertex><coordinates>");
+      for (int d = 0; d < 3; ++d) {
+        e = put(e, tags[d][0]);
+        e = std::to_chars(e, buf + sizeof buf, static_cast<double>(c[k][d])).ptr;
+        e = put(e, tags[d][1]);
+      }
+      e = put(e, "</coordinates></vertex>\n");
       v.append(buf, e);
     }
-    char* e = buf;
-    *e++ = 'f';
-    for (std::uint32_t i : id) *e++ = ' ', e = std::to_chars(e, buf + sizeof buf, i).ptr;
-    *e++ = '\n';
+    char* e = put(buf, "<triangle>");
+    const char* tags[3][2] = {{"<v1>", "</v1>"}, {"<v2>", "</v2>"}, {"<v3>", "</v3>"}};
+    for (int k = 0; k < 3; ++k) {
+      e = put(e, tags[k][0]);
+      e = std::to_chars(e, buf + sizeof buf, id[k]).ptr;
+      e = put(e, tags[k][1]);
+    }
+    e = put(e, "</triangle>\n");
     f.append(buf, e);
   }
-  return v + f;
+  std::string out =
+      "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<amf unit=\"millimeter\">\n"
+      "<object id=\"1\">\n";
+  for (const auto& [type, value] : metadata)
+    out += "<metadata type=\"" + type + "\">" + value + "</metadata>\n";
+  out.reserve(out.size() + v.size() + f.size() + 128);
+  out += "<mesh>\n<vertices>\n";
+  out += v;
+  out += "</vertices>\n<volume>\n";
+  out += f;
+  out += "</volume>\n</mesh>\n</object>\n</amf>\n";
+  return out;
 }
 
 Expected<void> write_ply_face_colors(const std::filesystem::path& file, const TriangleMesh& mesh,

@@ -282,7 +282,7 @@ EngineParams prusaslicer(const std::string& path = {}, const std::string& config
 }
 
 // start_engine_early (external_engine.hpp): PrusaSlicer started before the mesh exists reads it
-// from a pipe as OBJ, and writes what it writes of the STL.
+// from a pipe as AMF (its layer heights from another), and writes what it writes of the STL.
 TEST(EnginePrusaSlicer, AnEngineStartedEarlyWritesWhatOneStartedLateWrites) {
   if (!have_prusaslicer()) GTEST_SKIP() << "prusa-slicer not installed";
   PrintConfig c;
@@ -365,27 +365,35 @@ TEST(EnginePrusaSlicer, AnEarlyEngineStopsWhenCancelledOrDropped) {
   EXPECT_EQ(errno, ECHILD);
 }
 
-// A shell's two runs stop the early engine (on the wing it took a core from them: 0.78 ->
-// 0.69 s): none of our children is left while it is still held, and a run after it starts
-// its own.
-TEST(EnginePrusaSlicer, AStoppedEarlyEngineIsGoneAndNotTaken) {
+// A shell's core (a run with layer tops) takes the engine started early: the profile reaches
+// it in the AMF, the first layer's height through the settings pipe, as the 3MF and the
+// command line give them to one started late (on the wing that hid the core run's start:
+// 0.63 -> 0.5 s).
+TEST(EnginePrusaSlicer, AnEarlyEngineTakesACoreWithItsLayerProfile) {
   if (!have_prusaslicer()) GTEST_SKIP() << "prusa-slicer not installed";
   PrintConfig c;
   const EngineParams e = prusaslicer();
   const TriangleMesh mesh = test::placed(test::saddle(), c);
+  EngineRun core;
+  const double z0 = bounding_box(mesh).min.z();
+  for (double z : {0.17, 0.34, 0.52, 0.7, 0.87, 1.05, 1.22, 1.4, 1.57})
+    core.layer_tops.push_back(z0 + z);
   EarlyEnginePtr early = start_engine_early(e, c, mesh);
   ASSERT_NE(early, nullptr);
-  stop_early_engine(early.get());
+  auto piped = run_engine(e, mesh, c, {}, core, early.get());
+  ASSERT_TRUE(piped) << piped.error().message;
+  // It took the early one: no child of ours waits for its input any more.
   int status = 0;
   EXPECT_EQ(waitpid(-1, &status, WNOHANG), -1);
   EXPECT_EQ(errno, ECHILD);
-  stop_early_engine(early.get());  // twice: nothing more to do
-  stop_early_engine(nullptr);
-  auto r = run_engine(e, mesh, c, {}, {}, early.get());
-  ASSERT_TRUE(r) << r.error().message;
-  auto late = run_engine(e, mesh, c, {});
+  auto late = run_engine(e, mesh, c, {}, core);
   ASSERT_TRUE(late) << late.error().message;
-  expect_same_print(*r, *late);
+  expect_same_print(*piped, *late);
+  const Made p = made(*piped);
+  ASSERT_GT(p.layers.size(), 9u);
+  // The profile's layers, not first_layer_height's 0.2 and steps of 0.2.
+  EXPECT_NEAR(std::stod(p.layers[0].substr(3)), 0.17, 1e-3);
+  EXPECT_NEAR(std::stod(p.layers[8].substr(3)), 1.57, 1e-3);
 }
 
 TEST(EnginePrusaSlicer, NoEarlyEngineForAMeshPrusaSlicerWouldRepair) {

@@ -103,27 +103,49 @@ TEST(OffErrors, TruncatedLyingAndOutOfRange) {
   EXPECT_FALSE(io::parse_off("OFF\n-3 1 0\n"));
 }
 
-// obj_text is what PrusaSlicer reads through a pipe instead of our STL (external_engine.cpp):
+// The vertices and triangles of amf_text's object, read back (indices from 0).
+TriangleMesh read_amf_text(const std::string& text) {
+  TriangleMesh m;
+  auto values = [&](const char* open, const char* close) {
+    std::vector<double> out;
+    const std::string o = open, c = close;
+    for (std::size_t at = text.find(o); at != std::string::npos; at = text.find(o, at + 1)) {
+      const std::size_t from = at + o.size();
+      out.push_back(std::stod(text.substr(from, text.find(c, from) - from)));
+    }
+    return out;
+  };
+  const auto x = values("<x>", "</x>"), y = values("<y>", "</y>"), z = values("<z>", "</z>");
+  const auto a = values("<v1>", "</v1>"), b = values("<v2>", "</v2>"), c = values("<v3>", "</v3>");
+  for (std::size_t i = 0; i < x.size(); ++i) m.vertices.emplace_back(x[i], y[i], z[i]);
+  for (std::size_t i = 0; i < a.size(); ++i)
+    m.faces.push_back({static_cast<int>(a[i]), static_cast<int>(b[i]), static_cast<int>(c[i])});
+  return m;
+}
+
+// amf_text is what PrusaSlicer reads through a pipe instead of our STL (external_engine.cpp):
 // it must give the same floats, vertex for vertex, as the binary STL of the mesh.
-TEST(ObjText, ReadsBackAsTheBinaryStlOfTheMesh) {
+TEST(AmfText, ReadsBackAsTheBinaryStlOfTheMesh) {
   TriangleMesh m = test::icosphere(Vec3(110.3, 97.1, 12.0), 11.7, 3);
   for (Vec3& v : m.vertices) v.z() += 0.013 * std::sin(0.37 * v.x()) + 1e-7 / 3;  // off float
   std::size_t collapsed = 7;
-  const std::string text = obj_text(m, &collapsed);
+  const std::string text = amf_text(m, &collapsed, {{"slic3r.layer_height_profile", "0;0.2"}});
   EXPECT_EQ(collapsed, 0u);
-  auto back = io::parse_obj(text);
-  ASSERT_TRUE(back) << back.error().message;
-  const auto dir = test::temp_dir("obj_text");
+  EXPECT_EQ(text.rfind("<?xml", 0), 0u);
+  EXPECT_NE(text.find("<metadata type=\"slic3r.layer_height_profile\">0;0.2</metadata>"),
+            std::string::npos);
+  const TriangleMesh back = read_amf_text(text);
+  const auto dir = test::temp_dir("amf_text");
   ASSERT_TRUE(write_stl(dir / "m.stl", m));
   MeshFormat format{};
   auto stl = io::parse_stl(test::read_bytes(dir / "m.stl"), &format);
   ASSERT_TRUE(stl) << stl.error().message;
-  ASSERT_EQ(back->faces.size(), m.faces.size());
-  ASSERT_EQ(back->vertices.size(), m.vertices.size());  // shared as the mesh shares them
+  ASSERT_EQ(back.faces.size(), m.faces.size());
+  ASSERT_EQ(back.vertices.size(), m.vertices.size());  // shared as the mesh shares them
   ASSERT_EQ(stl->faces.size(), m.faces.size());
   for (std::size_t f = 0; f < m.faces.size(); ++f)
     for (int k = 0; k < 3; ++k) {
-      const Vec3& a = back->vertices[back->faces[f][k]];
+      const Vec3& a = back.vertices[static_cast<std::size_t>(back.faces[f][k])];
       const Vec3& b = stl->vertices[stl->faces[f][k]];
       for (int d = 0; d < 3; ++d) {
         ASSERT_EQ(a[d], b[d]) << "face " << f << " corner " << k;
@@ -132,17 +154,15 @@ TEST(ObjText, ReadsBackAsTheBinaryStlOfTheMesh) {
     }
 }
 
-TEST(ObjText, FacesThatCollapseInFloatAreLeftOutAndCounted) {
+TEST(AmfText, FacesThatCollapseInFloatAreLeftOutAndCounted) {
   TriangleMesh m;
   m.vertices = {{0, 0, 0}, {10, 0, 0}, {0, 10, 0}, {10 + 1e-7, 0, 0}};  // 1 and 3: one float
   m.faces = {{0, 1, 2}, {0, 3, 1}, {0, 2, 3}};
   std::size_t collapsed = 0;
-  const std::string text = obj_text(m, &collapsed);
+  const TriangleMesh back = read_amf_text(amf_text(m, &collapsed));
   EXPECT_EQ(collapsed, 1u);
-  auto back = io::parse_obj(text);
-  ASSERT_TRUE(back) << back.error().message;
-  EXPECT_EQ(back->faces.size(), 2u);
-  EXPECT_EQ(back->vertices.size(), 3u);  // 1 and 3 shared, as an STL reader shares them
+  EXPECT_EQ(back.faces.size(), 2u);
+  EXPECT_EQ(back.vertices.size(), 3u);  // 1 and 3 shared, as an STL reader shares them
 }
 
 }  // namespace
