@@ -359,20 +359,22 @@ Expected<void> feed(Launch& l, std::vector<std::pair<fs::path, std::string>> pip
     }
   } restore{pipe_signal, old};
   while (!pipes.empty()) {
-    bool opened = false;
-    for (auto it = pipes.begin(); it != pipes.end() && !opened; ++it) {
-      const int fd = ::open(it->first.c_str(), O_WRONLY | O_NONBLOCK | O_CLOEXEC);
+    // The first pipe the engine has opened for reading (open fails with ENXIO until then).
+    std::size_t k = 0;
+    int fd = -1;
+    for (; k < pipes.size() && fd < 0; ++k) {
+      fd = ::open(pipes[k].first.c_str(), O_WRONLY | O_NONBLOCK | O_CLOEXEC);
       if (fd < 0 && errno != ENXIO && errno != EINTR)
-        return Error{Status::io_error, "engine: cannot write its input " + it->first.string()};
-      if (fd < 0) continue;
-      opened = true;
-      auto wrote = write_pipe(fd, it->second, ctx);
+        return Error{Status::io_error, "engine: cannot write its input " + pipes[k].first.string()};
+    }
+    if (fd >= 0) {
+      auto wrote = write_pipe(fd, pipes[k - 1].second, ctx);
       ::close(fd);
       if (!wrote) return wrote.error();
       if (!*wrote) return {};
-      pipes.erase(it);
+      pipes.erase(pipes.begin() + static_cast<long>(k - 1));
+      continue;
     }
-    if (opened) continue;
     if (exited(l)) return {};
     if (ctx.cancelled()) return Error{Status::cancelled, "cancelled"};
     std::this_thread::sleep_for(std::chrono::milliseconds(1));
