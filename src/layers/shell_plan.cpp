@@ -227,8 +227,13 @@ double ShellPlan::thickness(int j, double x, double y) const {
 }
 
 ShellPlan plan_shell(const TriangleMesh& mesh, const Analysis& a, const std::vector<int>& patches,
-                     const LayerParams& p, double frame, bool even_core) {
+                     const LayerParams& p, double frame, bool even_core, const Context* cancel) {
   ShellPlan s;
+  auto cancelled = [&] {
+    if (!cancel || !cancel->cancelled()) return false;
+    s.refused = "cancelled";
+    return true;
+  };
   s.patches = patches;
   // The patches as one, with the printable facets beside them (shell_top): their facets, box
   // and height range (what faceted_top reads).
@@ -271,6 +276,7 @@ ShellPlan plan_shell(const TriangleMesh& mesh, const Analysis& a, const std::vec
     pad = 0, s.framed = true;
   }
   s.top = faceted_top(mesh, framed, 0.1, pad, std::tan(0.8 * p.max_angle_deg * kDeg) / M_SQRT2);
+  if (cancelled()) return s;
 
   // Where the part stands above H, the shell prints only in R (shell_region.hpp); inside R it
   // must rest on the core (rest_on_core: fewer layers over a thin wall, or what lies under it
@@ -282,6 +288,7 @@ ShellPlan plan_shell(const TriangleMesh& mesh, const Analysis& a, const std::vec
   // and the rib over a void left a shell point 0.100 mm over a later core layer 0.28 mm away).
   s.below = std::min(s.t - s.reach - 0.01, 0.5 * p.layer_height - 0.01);
   ShellRegion region = shell_region(mesh, in_patch, {}, 0, s.top, s.below, p, s.framed);
+  if (cancelled()) return s;
   if (!region.refused.empty()) {
     s.refused = region.refused;
     return s;
@@ -342,8 +349,8 @@ ShellPlan choose_first(const TriangleMesh& mesh, const Analysis& a, const LayerP
   const bool group = near.size() > 1 && near.size() < all.size();
   ShellPlan plan, some;
   core::parallel_for(0, group ? 2 : 1, [&](int k) {
-    if (k == 0) plan = plan_shell(mesh, a, all, p, 0, c.even_core);
-    if (k == 1) some = plan_shell(mesh, a, near, p, 0, c.even_core);
+    if (k == 0) plan = plan_shell(mesh, a, all, p, 0, c.even_core, c.cancel);
+    if (k == 1) some = plan_shell(mesh, a, near, p, 0, c.even_core, c.cancel);
   });
   // The ankle base's rim prints as a shell, its ledge planar: say why not both.
   auto narrowed = [&](ShellPlan s, const std::vector<int>& wider, const std::string& why) {
@@ -357,7 +364,7 @@ ShellPlan choose_first(const TriangleMesh& mesh, const Analysis& a, const LayerP
   if (!plan.refused.empty() && group && some.refused.empty())
     return narrowed(std::move(some), all, plan.refused);
   if (!plan.refused.empty() && all.size() > 1) {
-    ShellPlan one = plan_shell(mesh, a, {all.front()}, p, 0, c.even_core);
+    ShellPlan one = plan_shell(mesh, a, {all.front()}, p, 0, c.even_core, c.cancel);
     if (one.refused.empty())
       return narrowed(std::move(one), group ? near : all, group ? some.refused : plan.refused);
   }
@@ -419,9 +426,9 @@ std::vector<ShellPlan> choose_shells(const TriangleMesh& mesh, const Analysis& a
   core::parallel_for(std::size_t(0), groups.size(), [&](std::size_t k) {
     const std::vector<int>& group = groups[k];
     if (!apart(patch_box(a, group), patch_box(a, first.patches), p.toolhead.reach())) return;
-    tried[k] = plan_shell(mesh, a, group, p, frame, c.even_core);
+    tried[k] = plan_shell(mesh, a, group, p, frame, c.even_core, c.cancel);
     if (!tried[k].refused.empty() && group.size() > 1)
-      tried[k] = plan_shell(mesh, a, {group.front()}, p, frame, c.even_core);
+      tried[k] = plan_shell(mesh, a, {group.front()}, p, frame, c.even_core, c.cancel);
   });
   for (std::size_t k = 0; k < groups.size() && static_cast<int>(shells.size()) < most; ++k) {
     if (near_a_shell(groups[k])) continue;
@@ -435,7 +442,8 @@ std::vector<ShellPlan> choose_shells(const TriangleMesh& mesh, const Analysis& a
 
 std::vector<ShellPlan> choose_shells_beside(const TriangleMesh& mesh, const Analysis& a,
                                             const LayerParams& p, const std::vector<int>& stacked,
-                                            std::vector<int>& rest, std::string& why) {
+                                            std::vector<int>& rest, std::string& why,
+                                            const Context* cancel) {
   rest.clear(), why.clear();
   double curved = 0, left = 0;
   for (int i : curved_among(a, {})) {
@@ -448,7 +456,7 @@ std::vector<ShellPlan> choose_shells_beside(const TriangleMesh& mesh, const Anal
   constexpr double kLeast = 0.05;
   if (rest.empty() || left < kLeast * curved) return rest.clear(), std::vector<ShellPlan>{};
   ShellChoice c;
-  c.among = rest, c.even_core = true;
+  c.among = rest, c.even_core = true, c.cancel = cancel;
   std::vector<ShellPlan> shells = choose_shells(mesh, a, p, c);
   const ShellPlan& first = shells.front();
   if (!first.refused.empty())

@@ -23,6 +23,7 @@
 
 #include "layers/faceted_top.hpp"
 #include "layers/shell_region.hpp"
+#include "nonplanar/context.hpp"
 #include "nonplanar/layers.hpp"
 
 namespace nonplanar::layers {
@@ -80,8 +81,11 @@ struct ShellPlan {
 /// that much (mm), and R stops short of its edge (plan.framed).
 /// `even_core`: every core layer h_c thick after the first (no landing on flat patches), so
 /// the core's boundaries are planar layers PlanarLayers{z_1, h_c} that stacks can share.
+/// `cancel` (if given): once set, the plan stops between its steps, refused "cancelled" (each
+/// step takes up to a second or two on a large part under a sanitizer).
 ShellPlan plan_shell(const TriangleMesh& mesh, const Analysis& a, const std::vector<int>& patches,
-                     const LayerParams& p, double frame = 0, bool even_core = false);
+                     const LayerParams& p, double frame = 0, bool even_core = false,
+                     const Context* cancel = nullptr);
 
 /// The shell `slice` tries when no stack can be built, or when the stacks cover less than half
 /// the largest curved patch: all the patches that need curved layers as one top, or failing
@@ -104,6 +108,7 @@ struct ShellChoice {
   int most = 4;            ///< shells at most
   std::vector<int> among;  ///< the patches to follow (empty: every one that needs curved layers)
   bool even_core = false;  ///< plan_shell's: a core whose layers stacks can share
+  const Context* cancel = nullptr;  ///< plan_shell's: stop when this is cancelled
 };
 /// choose_shells over `c.among` only (the patches no stack serves, beside the stacks).
 std::vector<ShellPlan> choose_shells(const TriangleMesh& mesh, const Analysis& a,
@@ -117,7 +122,8 @@ std::vector<ShellPlan> choose_shells(const TriangleMesh& mesh, const Analysis& a
 /// layers and checks that no shell cuts the core inside their bands.
 std::vector<ShellPlan> choose_shells_beside(const TriangleMesh& mesh, const Analysis& a,
                                             const LayerParams& p, const std::vector<int>& stacked,
-                                            std::vector<int>& rest, std::string& why);
+                                            std::vector<int>& rest, std::string& why,
+                                            const Context* cancel = nullptr);
 
 /// The shell's layer field: T = N + (z − H)/t, ζ = base + t·T, so the normalised mesh holds
 /// the shell's layers as planes ζ = base + j·t … base + (j + 1)·t. Every column is curved.

@@ -185,11 +185,13 @@ std::vector<int> shell_patches(const std::vector<layers::ShellPlan>& shells) {
 }
 
 // layers::choose_shells, one shell only through an external engine (its two runs take one)
-// or for one slicer run (prepare).
+// or for one slicer run (prepare); stopped when ctx is cancelled.
 std::vector<layers::ShellPlan> shells_for(const TriangleMesh& mesh, const Analysis& a,
-                                          const SliceJob& job) {
-  const bool several = job.engine.engine == Engine::builtin && !job.one_run_shells;
-  return layers::choose_shells(mesh, a, job.layers, several ? 4 : 1);
+                                          const SliceJob& job, const Context& ctx) {
+  layers::ShellChoice c;
+  c.most = job.engine.engine == Engine::builtin && !job.one_run_shells ? 4 : 1;
+  c.cancel = &ctx;
+  return layers::choose_shells(mesh, a, job.layers, c);
 }
 
 // The header lines and notices of the shells printed (r's), from the planar attempt's.
@@ -348,7 +350,7 @@ Expected<std::optional<SliceResult>> shell_over_stacks(const TriangleMesh& mesh,
                                                        SliceResult& stacked, EarlyEngine* early,
                                                        const Context& ctx) {
   ctx.progress("shell", 0);
-  std::vector<layers::ShellPlan> shells = shells_for(mesh, a, job);
+  std::vector<layers::ShellPlan> shells = shells_for(mesh, a, job, ctx);
   const double stacks = area_of(a, stacked_patches(stacked.plan));
   if (!shells.front().refused.empty() || !(area_of(a, shell_patches(shells)) > 2 * stacks))
     return std::optional<SliceResult>{};
@@ -405,7 +407,7 @@ Expected<std::optional<SliceResult>> shells_beside_stacks(const TriangleMesh& me
                                     [](const Patch& q) { return q.needs_nonplanar(); });
   if (static_cast<std::size_t>(curved) > stacked_ids.size()) ctx.progress("shell", 0);
   std::vector<layers::ShellPlan> shells =
-      layers::choose_shells_beside(mesh, a, job.layers, stacked_ids, rest, refused);
+      layers::choose_shells_beside(mesh, a, job.layers, stacked_ids, rest, refused, &ctx);
   // Why not, said of the patches left planar (the run's summary gives the first reason).
   auto not_beside = [&](const std::string& why) {
     stacked.notices.push_back(
@@ -514,6 +516,8 @@ Expected<SliceResult> slice_rounds(const TriangleMesh& mesh, const SliceJob& job
     auto r = attempt(mesh, job, pre, excluded, &offenders, shells ? &deferred : nullptr,
                      !over_stacks_tried, ctx);
     if (!r) return r;
+    // Before planning shells (seconds on a large part under a sanitizer, past Ctrl-C's grace).
+    if (ctx.cancelled()) return Error{Status::cancelled, "cancelled"};
     if (deferred && !r->plan.stacks.empty()) {
       // Stacks that cover little: a shell over the largest patch first, before they are sliced.
       over_stacks_tried = true;
@@ -535,7 +539,7 @@ Expected<SliceResult> slice_rounds(const TriangleMesh& mesh, const SliceJob& job
       // top is two, split at a crease); failing that, the group round the largest, or the
       // largest alone; and a shell per further curved region the part stands above.
       auto shell = try_shells(
-          mesh, job, pre.analysis, shells_for(mesh, pre.analysis, job),
+          mesh, job, pre.analysis, shells_for(mesh, pre.analysis, job, ctx),
           [&](double) {
             return std::string(stacks_broke ? "its stacks broke a limit in their final paths"
                                             : "no stack over a plane fits it");

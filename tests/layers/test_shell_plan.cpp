@@ -3,6 +3,8 @@
 // them, and the parts it must refuse.
 #include <gtest/gtest.h>
 
+#include <atomic>
+
 #include "nonplanar/io.hpp"
 
 #include <cmath>
@@ -74,6 +76,23 @@ TEST(ShellPlan, RibStairsStayInsideTheLimits) {
         }
     }
   EXPECT_GT(filled, 1000);  // most of the rib has core under its shell
+}
+
+// Ctrl-C while shells are planned: the plan stops between its steps (the bunny's shells took
+// 4 s under ThreadSanitizer, and an interrupt's 10 s of grace ran out in CI), and
+// choose_shells passes the flag on.
+TEST(ShellPlan, StopsWhenCancelled) {
+  const TriangleMesh m = test::rib();
+  const Analysis a = *analyze(m, {}, {});
+  ASSERT_TRUE(layers::plan_shell(m, a, curved(a), LayerParams{}).refused.empty());
+  std::atomic<bool> stop{true};
+  Context cancelled;
+  cancelled.cancel_flag = &stop;
+  EXPECT_EQ(layers::plan_shell(m, a, curved(a), LayerParams{}, 0, false, &cancelled).refused,
+            "cancelled");
+  layers::ShellChoice c;
+  c.cancel = &cancelled;
+  EXPECT_EQ(layers::choose_shells(m, a, LayerParams{}, c).front().refused, "cancelled");
 }
 
 TEST(ShellPlan, CoreLandsOnAFlatFloorInside) {
