@@ -135,10 +135,13 @@ std::vector<std::string> engine_shell_settings(double first_layer) {
       slab};
 }
 
+namespace {
+
 // Pairs (z, height) PrusaSlicer interpolates linearly, looked up a little above each layer's
 // bottom; each layer gets two equal points (its bottom and middle), so its height is exact.
-std::string layer_height_profile(const std::vector<double>& tops, double h, double top) {
-  std::string s = "object_id=1|";
+// "z;h;z;h;…", as a 3MF's profile holds them after its object and an AMF's metadata holds them.
+std::string layer_height_pairs(const std::vector<double>& tops, double h, double top) {
+  std::string s;
   char buf[64];
   double b = 0;
   auto layer = [&](double t) {
@@ -149,8 +152,14 @@ std::string layer_height_profile(const std::vector<double>& tops, double h, doub
   for (double z : tops)
     if (z > b + 1e-6) layer(z - b), b = z;
   while (b + h < top - 1e-6) layer(h);
-  std::snprintf(buf, sizeof buf, "%.6f;%.6f\n", top, h);
+  std::snprintf(buf, sizeof buf, "%.6f;%.6f", top, h);
   return s + buf;
+}
+
+}  // namespace
+
+std::string layer_height_profile(const std::vector<double>& tops, double h, double top) {
+  return "object_id=1|" + layer_height_pairs(tops, h, top) + "\n";
 }
 
 namespace {
@@ -457,31 +466,26 @@ EarlyEnginePtr start_engine_early(const EngineParams& e, const PrintConfig& c,
 
 namespace {
 
-// The layer-height profile of a run of `mesh` (none: empty): PrusaSlicer's pairs over the
-// mesh's lowest point.
-std::string run_profile(const TriangleMesh& mesh, const PrintConfig& c, const EngineRun& run) {
-  if (run.layer_tops.empty()) return {};
-  const BoundingBox box = bounding_box(mesh);
+// The tops of a run's layers over the lowest point of a mesh whose box is `box` (none: empty).
+std::vector<double> run_tops(const BoundingBox& box, const EngineRun& run) {
   std::vector<double> tops;
   for (double z : run.layer_tops) tops.push_back(z - box.min.z());
-  return layer_height_profile(tops, c.slice.layer_height, box.max.z() - box.min.z());
+  return tops;
 }
 
 // The run given to the engine started early: its layer heights, then the mesh as AMF (with
 // the profile, if any), as the engine opens the two pipes. Empty: it cannot take this mesh
 // (faces that collapse in float: the STL of a run started late lets PrusaSlicer repair them).
 std::optional<Expected<std::string>> run_early(EarlyEngine& early, const EngineParams& e,
-                                               const TriangleMesh& mesh, const PrintConfig& c,
-                                               const Context& ctx, const EngineRun& run,
-                                               double first_layer) {
+                                               const TriangleMesh& mesh, const BoundingBox& box,
+                                               const PrintConfig& c, const Context& ctx,
+                                               const EngineRun& run, double first_layer) {
   std::size_t collapsed = 0;
   std::vector<std::pair<std::string, std::string>> metadata;
-  if (std::string profile = run_profile(mesh, c, run); !profile.empty()) {
-    // The 3MF's text without its object and line end: "z;h;z;h;…".
-    profile = profile.substr(profile.find('|') + 1);
-    if (!profile.empty() && profile.back() == '\n') profile.pop_back();
-    metadata.emplace_back("slic3r.layer_height_profile", profile);
-  }
+  if (!run.layer_tops.empty())
+    metadata.emplace_back(
+        "slic3r.layer_height_profile",
+        layer_height_pairs(run_tops(box, run), c.slice.layer_height, box.max.z() - box.min.z()));
   std::string amf = amf_text(mesh, &collapsed, metadata);
   if (collapsed != 0) return std::nullopt;
   Launch& l = early.launch;
@@ -508,7 +512,7 @@ Expected<std::string> run_engine(const EngineParams& e, const TriangleMesh& mesh
   // is centred elsewhere and changes more settings than the layers' heights.
   if (early && !orca && run.slab_layer_height <= 0 && centre == early->centre &&
       !early->taken.exchange(true))
-    if (auto gcode = run_early(*early, e, mesh, c, ctx, run, h1))
+    if (auto gcode = run_early(*early, e, mesh, box, c, ctx, run, h1))
       // A pipe that could not be written, or a PrusaSlicer that failed (one whose readers seek
       // in an ini or AMF too, or a bad profile): run again as before, from files; the user
       // gets its file, or what that run says.
@@ -516,7 +520,9 @@ Expected<std::string> run_engine(const EngineParams& e, const TriangleMesh& mesh
   Launch l(profile ? "core.3mf" : "normalized.stl");
   if (l.dir.path.empty()) return Error{Status::io_error, "engine: cannot make a temporary folder"};
   if (profile) {
-    const PackageFile f{"/Metadata/Slic3r_PE_layer_heights_profile.txt", run_profile(mesh, c, run)};
+    const PackageFile f{
+        "/Metadata/Slic3r_PE_layer_heights_profile.txt",
+        layer_height_profile(run_tops(box, run), c.slice.layer_height, box.max.z() - box.min.z())};
     if (auto w = write_3mf(l.input, mesh, {f}); !w) return w.error();
   } else if (auto w = write_stl(l.input, mesh); !w) {
     return w.error();

@@ -333,6 +333,7 @@ Expected<std::optional<SliceResult>> try_shells(const TriangleMesh& mesh, const 
   if (!printed || *printed || shells.size() == 1) return printed;
   const double first = area_of(a, shells.front().patches);
   if (!(first > min_area)) return printed;
+  if (ctx.cancelled()) return Error{Status::cancelled, "cancelled"};  // before planning again
   shells.assign(1, layers::choose_shell(mesh, a, job.layers));
   return try_shell(mesh, job, shells, why(first), planar, spent, early, ctx);
 }
