@@ -1,12 +1,18 @@
 // The pipeline (DESIGN.md §2): every stage is a free function; this only chains them and
 // checks the result against DESIGN.md §3 before anyone writes it.
+#include <malloc.h>
+
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <functional>
 #include <optional>
+#include <thread>
 
+#include "core/ahead_run.hpp"
 #include "core/column_caster.hpp"
+#include "core/sanitizers.hpp"
 #include "engine/engine_route.hpp"
 #include "layers/banded_field.hpp"
 #include "nonplanar/deform.hpp"
@@ -38,7 +44,7 @@ std::vector<int> stacked_patches(const LayerPlan& plan) {
 }
 
 // Whether a shell could cover more than twice what the stacks do: all curved patches together
-// must (shell_over_stacks then asks it of the shell it plans).
+// must (shell_before_stacks then asks it of the shell it plans).
 bool shell_may_cover_more(const Analysis& a, const LayerPlan& plan) {
   std::vector<int> curved;
   for (std::size_t i = 0; i < a.patches.size(); ++i)
@@ -338,32 +344,6 @@ Expected<std::optional<SliceResult>> try_shells(const TriangleMesh& mesh, const 
   return try_shell(mesh, job, shells, why(first), planar, spent, early, ctx);
 }
 
-// A part whose stacks follow only a little of its curved top (the CurviSlicer car: 172 mm² of
-// roof, while its 486 mm² body, hollow under the hood, has none): a shell instead, if that
-// plans and passes the gate: over all its curved patches (the car: 1065 mm², 84 % of its
-// curved top within 0.03 mm, where the body alone gave 57 %), else over the group round the
-// largest or the largest alone, and one per further curved region (layers::choose_shells). Stacks
-// follow the top more closely and cost no bands, so the shell must cover more than twice their area
-// (shell_may_cover_more asks it of all curved patches first; `stacked` is an attempt it deferred,
-// its stacks planned but not sliced; none returned: the caller slices them).
-Expected<std::optional<SliceResult>> shell_over_stacks(const TriangleMesh& mesh,
-                                                       const SliceJob& job, const Analysis& a,
-                                                       SliceResult& stacked, EarlyEngine* early,
-                                                       const Context& ctx) {
-  ctx.progress("shell", 0);
-  std::vector<layers::ShellPlan> shells = shells_for(mesh, a, job, ctx);
-  const double stacks = area_of(a, stacked_patches(stacked.plan));
-  if (!shells.front().refused.empty() || !(area_of(a, shell_patches(shells)) > 2 * stacks))
-    return std::optional<SliceResult>{};
-  auto why = [&](double area) {
-    char buf[160];
-    std::snprintf(buf, sizeof buf, "its %.0f mm² print curved, where stacks would cover %.0f mm²",
-                  area, stacks);
-    return std::string(buf);
-  };
-  return try_shells(mesh, job, a, std::move(shells), why, 2 * stacks, stacked, early, ctx);
-}
-
 // Where a shell cuts the core inside a stack's band (none: nowhere). Core layer k is cut
 // inside a shell's R where z_k > B + a, at the core's planar height, which a band's curved
 // layers are not at. Looked at every 0.5 mm of each band's reach (1 mm of slack): material
@@ -486,6 +466,84 @@ Notice dropped_notice(const SliceResult& r, int patch, const std::string& why,
 }
 
 // slice_model's rounds: attempts, retries without the patches that broke a limit, shells.
+// shells_for while `engine` runs: at idle priority, so as not to slow the engine's run (the
+// plan is needed only once it is done; PrusaSlicer slices on both cores at first), unless the
+// run is done first (the machine busy with other work, or a short run): then planned again at
+// the caller's priority. Either plan is the same.
+std::vector<layers::ShellPlan> plan_beside(const TriangleMesh& mesh, const Analysis& a,
+                                           const SliceJob& job,
+                                           const core::AheadRun<Expected<SliceResult>>& engine,
+                                           const Context& ctx) {
+  core::AheadRun<std::vector<layers::ShellPlan>> idle(
+      ctx, [&](const Context& c) { return shells_for(mesh, a, job, c); }, core::Priority::idle);
+  while (!idle.ready() && !engine.ready() && !ctx.cancelled())
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  if (idle.ready()) return idle.get();
+  if (ctx.cancelled()) return {};        // (the caller returns at once)
+  return shells_for(mesh, a, job, ctx);  // (idle is stopped on the way out)
+}
+
+// A part whose stacks follow only a little of its curved top (the CurviSlicer car: 172 mm² of
+// roof, while its 486 mm² body, hollow under the hood, has none): a shell instead, if that
+// plans and passes the gate: over all its curved patches (the car: 1065 mm², 84 % of its
+// curved top within 0.03 mm, where the body alone gave 57 %), else over the group round the
+// largest or the largest alone, and one per further curved region (layers::choose_shells).
+// Stacks follow the top more closely and cost no bands, so the shell must cover more than
+// twice their area (shell_may_cover_more asks it of all curved patches first; `stacked` is an
+// attempt it deferred, its stacks planned but not sliced). Output: the shell's result when it
+// prints; else none, with the stacks' attempt sliced in `stacks` (their offenders in
+// `offenders`) and why the shell did not print in stacked.notices.
+// Through another slicer the stacks' run starts at once, beside the shell's planning, and is
+// stopped should the shell print: one run prints a shell only where the part stands nowhere
+// above it, so the bunny, Benchy, the ornament, the car and the spiky block all refuse theirs,
+// and the run is most of the time (the bunny's shell took 0.35 s to plan, PrusaSlicer 5.8 s
+// after it). The plan meanwhile takes only what the engine leaves of the cores: PrusaSlicer
+// slices on both at first, and the plan is needed only once its run is done.
+Expected<std::optional<SliceResult>> shell_before_stacks(
+    const TriangleMesh& mesh, const SliceJob& job, const Prepared& pre,
+    const std::vector<int>& excluded, SliceResult& stacked,
+    std::optional<Expected<SliceResult>>& stacks,
+    std::vector<std::pair<int, std::string>>& offenders, const Context& ctx) {
+  std::vector<std::pair<int, std::string>> ahead_offenders;
+  std::optional<core::AheadRun<Expected<SliceResult>>> ahead;
+  if (job.engine.engine != Engine::builtin)
+    ahead.emplace(ctx, [&](const Context& c) {
+      return attempt(mesh, job, pre, excluded, &ahead_offenders, nullptr, false, c);
+    });
+  ctx.progress("shell", 0);
+  std::vector<layers::ShellPlan> shells = ahead ? plan_beside(mesh, pre.analysis, job, *ahead, ctx)
+                                                : shells_for(mesh, pre.analysis, job, ctx);
+  if (ctx.cancelled()) return Error{Status::cancelled, "cancelled"};
+  const double area = area_of(pre.analysis, stacked_patches(stacked.plan));
+  if (shells.front().refused.empty() && area_of(pre.analysis, shell_patches(shells)) > 2 * area) {
+    // A shell that may print: the cores go to it (should it not, the stacks are sliced again).
+    if (ahead && shells.front().region.empty()) ahead->drop();
+    auto why = [&](double curved) {
+      char buf[160];
+      std::snprintf(buf, sizeof buf, "its %.0f mm² print curved, where stacks would cover %.0f mm²",
+                    curved, area);
+      return std::string(buf);
+    };
+    auto shell = try_shells(mesh, job, pre.analysis, std::move(shells), why, 2 * area, stacked,
+                            ahead ? nullptr : pre.engine.get(), ctx);
+    if (!shell || *shell) return shell;
+  }
+  // The plans go before the stacks are mapped back, and the idle plan's thread had an
+  // allocator arena of its own, which keeps what was freed in it: handed back (the bunny's
+  // peak through PrusaSlicer 359 MB with it kept, 317 MB without; 324 MB planned in turn).
+  std::vector<layers::ShellPlan>().swap(shells);
+#if defined(__GLIBC__) && !defined(NONPLANAR_SHADOW_MEMORY)
+  if (ahead) malloc_trim(0);
+#endif
+  if (ahead && ahead->running()) {
+    stacks = ahead->get();
+    offenders = std::move(ahead_offenders);
+  } else {
+    stacks = attempt(mesh, job, pre, excluded, &offenders, nullptr, false, ctx);
+  }
+  return std::optional<SliceResult>{};
+}
+
 Expected<SliceResult> slice_rounds(const TriangleMesh& mesh, const SliceJob& job,
                                    const Context& ctx) {
   Prepared pre;
@@ -520,17 +578,17 @@ Expected<SliceResult> slice_rounds(const TriangleMesh& mesh, const SliceJob& job
     // Before planning shells (seconds on a large part under a sanitizer, past Ctrl-C's grace).
     if (ctx.cancelled()) return Error{Status::cancelled, "cancelled"};
     if (deferred && !r->plan.stacks.empty()) {
-      // Stacks that cover little: a shell over the largest patch first, before they are sliced.
       over_stacks_tried = true;
       r->notices.insert(r->notices.begin(), dropped.begin(), dropped.end());
-      auto shell = shell_over_stacks(mesh, job, pre.analysis, *r, pre.engine.get(), ctx);
+      std::optional<Expected<SliceResult>> stacks;
+      auto shell = shell_before_stacks(mesh, job, pre, excluded, *r, stacks, offenders, ctx);
       if (!shell) return shell.error();
       if (*shell) return done(std::move(**shell));
       // The stacks, then; and why the shell did not print, if it got as far as the gate (kept
       // through the rounds, as the patches dropped are).
       for (const Notice& n : r->notices)
         if (n.kind == Notice::Kind::shell_refused) dropped.push_back(n);
-      r = attempt(mesh, job, pre, excluded, &offenders, nullptr, false, ctx);
+      r = std::move(*stacks);
       if (!r) return r;
     } else if (deferred) {
       // No curved stack: a shell, or else the same attempt sliced planar (its stacks cached).

@@ -175,6 +175,16 @@ TriangleMesh rib_and_domed_tower() {
   return m;
 }
 
+TriangleMesh rib_and_small_domed_tower() {
+  TriangleMesh m = rib();
+  append(m, height_field_solid(
+                [](double x, double y) {
+                  return 18 + 2 * std::cos(0.1 * (x - 95)) * std::cos(0.1 * (y - 6));
+                },
+                87.5, 102.5, -1.5, 13.5, 30, 30));
+  return m;
+}
+
 TriangleMesh two_reliefs() {
   auto top = [](double x, double y) {
     if (x < 25) return 4 + 3 * std::sin(2 * M_PI * x / 25) * std::cos(y / 8);
