@@ -32,9 +32,7 @@ Expected<EngineOutput> builtin(const TriangleMesh& to_slice, const LayerField* f
 Expected<EngineOutput> external(const TriangleMesh& to_slice, const LayerField* field,
                                 const EngineRoute& route, const Context& ctx) {
   ctx.progress("engine", 0);
-  EngineRun run;
-  if (field) run.resolution = NormalizeParams{}.tolerance;  // (slice_model's map)
-  auto text = run_engine(route.engine, to_slice, route.print, ctx, run, route.early);
+  auto text = run_engine(route.engine, to_slice, route.print, ctx, {}, route.early);
   if (!text) return text.error();
   ctx.progress("map back", 0);
   const auto planar = planar_field(route.layers);

@@ -12,9 +12,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
-#include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -23,7 +21,6 @@
 #include <thread>
 
 #include "core/mesh_topology.hpp"
-#include "nonplanar/deform.hpp"
 #include "nonplanar/io.hpp"
 
 extern char** environ;
@@ -100,18 +97,6 @@ std::string last_line(const fs::path& log) {
 
 }  // namespace
 
-double engine_resolution(const EngineParams& e, const PrintConfig& c, const EngineRun& run) {
-  if (e.engine != Engine::prusaslicer || !(run.resolution > 0)) return 0;
-  double own = 0;
-  if (const auto it = c.profile.find("resolution"); it != c.profile.end()) {
-    const char* text = it->second.c_str();
-    char* end = nullptr;
-    own = std::strtod(text, &end);
-    if (end == text || !std::isfinite(own)) own = 0;
-  }
-  return own < run.resolution ? run.resolution : 0;
-}
-
 std::vector<std::string> engine_forced_settings(const EngineParams& e, const PrintConfig& c) {
   if (e.engine == Engine::builtin) return {};
   // OrcaSlicer's command line cannot override them: they are what its profile must say.
@@ -124,9 +109,6 @@ std::vector<std::string> engine_forced_settings(const EngineParams& e, const Pri
       "arc_fitting = disabled",
       std::string("E distances: ") + (c.gcode.relative_e ? "relative" : "absolute") +
           " (as the profile says)"};
-  if (e.engine == Engine::prusaslicer)
-    s.push_back("resolution = " + num(NormalizeParams{}.tolerance) +
-                " where the profile's is finer, on a normalised mesh (the map's accuracy)");
   for (std::string& v : s) v = how + v;
   return s;
 }
@@ -287,8 +269,6 @@ Expected<std::vector<std::string>> engine_args(const EngineParams& e, const Prin
     args.insert(args.end(), {"--load", l.settings.string()});
   else
     args.insert(args.end(), {"--layer-height", num(h), "--first-layer-height", num(first_layer)});
-  if (const double r = engine_resolution(e, c, run); r > 0 && l.settings.empty())
-    args.insert(args.end(), {"--resolution", num(r)});
   args.insert(args.end(), {"--retract-lift", "0", "--no-spiral-vase", "--center",
                            num(centre.x()) + "," + num(centre.y())});
   if (e.config.empty()) {
@@ -344,13 +324,9 @@ bool exited(Launch& l) {
 
 // The layer heights of a run whose engine reads them from l.settings (the --layer-height and
 // --first-layer-height engine_args gives a run started late).
-std::string run_settings(const EngineParams& e, const PrintConfig& c, const EngineRun& run,
-                         double first_layer) {
+std::string run_settings(const PrintConfig& c, const EngineRun& run, double first_layer) {
   const double h = run.slab_layer_height > 0 ? run.slab_layer_height : c.slice.layer_height;
-  std::string text =
-      "layer_height = " + num(h) + "\nfirst_layer_height = " + num(first_layer) + "\n";
-  if (const double r = engine_resolution(e, c, run); r > 0) text += "resolution = " + num(r) + "\n";
-  return text;
+  return "layer_height = " + num(h) + "\nfirst_layer_height = " + num(first_layer) + "\n";
 }
 
 // Writes a pipe's text fully into it once opened (false: the engine stopped reading: it
@@ -515,7 +491,7 @@ std::optional<Expected<std::string>> run_early(EarlyEngine& early, const EngineP
   Launch& l = early.launch;
   l.waiting = false;
   auto fed =
-      feed(l, {{l.settings, run_settings(e, c, run, first_layer)}, {l.input, std::move(amf)}}, ctx);
+      feed(l, {{l.settings, run_settings(c, run, first_layer)}, {l.input, std::move(amf)}}, ctx);
   return fed ? finish(l, e, c, ctx) : Expected<std::string>(fed.error());
 }
 

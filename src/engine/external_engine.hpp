@@ -28,15 +28,7 @@ struct EngineRun {
   /// skirt or brim, and its first layer printed like the others (speed, width, fan, no
   /// elephant-foot compensation).
   double slab_layer_height = 0;
-  /// > 0: the mesh is normalised, within this of the exact map (mm), and PrusaSlicer simplifies
-  /// its slices to it (`resolution`) where the profile's is finer: the map's splits (the bunny's
-  /// 1872 faces became 8982) only add vertices there, and PrusaSlicer's time grows with them.
-  double resolution = 0;
 };
-
-/// The slice resolution a PrusaSlicer run is given (mm; 0: the profile's own): run.resolution
-/// where the profile's `resolution` (c.profile; PrusaSlicer's default 0) is finer.
-double engine_resolution(const EngineParams& e, const PrintConfig& c, const EngineRun& run);
 
 /// PrusaSlicer's layer-height profile (Metadata/Slic3r_PE_layer_heights_profile.txt) of the
 /// 3MF's first object: layers ending at `tops` (mm over the object's lowest point, rising),

@@ -166,11 +166,9 @@ Expected<EngineShell> shell_with_engine(const TriangleMesh& mesh, const layers::
       std::async(std::launch::async, [&] { return core_with_engine(mesh, plan, job, quiet); });
   // The shell: the normalised mesh's slab 0 <= ζ <= N·t.
   const layers::ShellField field(plan);
-  const NormalizeParams np = shell_normalize_params(mesh);
-  auto normalized = normalize_mesh(mesh, field, np, ctx);
+  auto normalized = normalize_mesh(mesh, field, shell_normalize_params(mesh), ctx);
   EngineRun shell_run;
   shell_run.slab_layer_height = plan.t;
-  shell_run.resolution = np.tolerance;
   Expected<std::string> shell_text =
       normalized
           ? run_engine(job.engine, cut_below(normalized->mesh, 0.0), job.print, ctx, shell_run)

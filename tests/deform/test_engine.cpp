@@ -11,7 +11,6 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <iterator>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -395,72 +394,6 @@ TEST(EnginePrusaSlicer, AnEarlyEngineTakesACoreWithItsLayerProfile) {
   // The profile's layers, not first_layer_height's 0.2 and steps of 0.2.
   EXPECT_NEAR(std::stod(p.layers[0].substr(3)), 0.17, 1e-3);
   EXPECT_NEAR(std::stod(p.layers[8].substr(3)), 1.57, 1e-3);
-}
-
-// A normalised mesh's slices are simplified to the map's own accuracy where the profile's
-// resolution is finer (PrusaSlicer's time grows with the vertices the map's splits add), from
-// the run's ini when started early, on the command line when started late; the part's own
-// runs, and a profile as coarse, keep the profile's.
-TEST(EngineResolution, TheMapsAccuracyWhereTheProfileIsFiner) {
-  PrintConfig c;
-  EngineRun normalised;
-  normalised.resolution = 0.01;
-  EXPECT_EQ(engine_resolution(prusaslicer(), c, normalised), 0.01);  // no key: PrusaSlicer's 0
-  EXPECT_EQ(engine_resolution(prusaslicer(), c, {}), 0.0);
-  c.profile["resolution"] = "0";
-  EXPECT_EQ(engine_resolution(prusaslicer(), c, normalised), 0.01);
-  c.profile["resolution"] = "0.0125";
-  EXPECT_EQ(engine_resolution(prusaslicer(), c, normalised), 0.0);
-  EngineParams orca;
-  orca.engine = Engine::orcaslicer;
-  EXPECT_EQ(engine_resolution(orca, PrintConfig{}, normalised), 0.0);
-  const auto forced = engine_forced_settings(prusaslicer(), PrintConfig{});
-  EXPECT_TRUE(std::any_of(forced.begin(), forced.end(), [](const std::string& l) {
-    return l.rfind("resolution = 0.01 where the profile's is finer", 0) == 0;
-  }));
-}
-
-TEST(EnginePrusaSlicer, ANormalisedMeshIsSlicedAtTheMapsResolution) {
-  if (!have_prusaslicer()) GTEST_SKIP() << "prusa-slicer not installed";
-  const std::filesystem::path dir = test::temp_dir("engine_resolution");
-  const std::filesystem::path log = dir / "runs.log", exe = dir / "prusa-slicer";
-  {
-    // Logs each run's arguments and the files it loads (a pipe's text copied, then given).
-    std::ofstream sh(exe);
-    sh << "#!/bin/bash\nargs=(); prev=; n=0\nfor a in \"$@\"; do\n"
-          "  if [ \"$prev\" = --load ]; then n=$((n+1)); f='"
-       << dir.string() << "'/load$$.$n; cat \"$a\" > \"$f\"; cat \"$f\" >> '" << log.string()
-       << "'; args+=(\"$f\"); else args+=(\"$a\"); fi; prev=$a\ndone\n"
-          "echo \"run: $*\" >> '"
-       << log.string() << "'\nexec prusa-slicer \"${args[@]}\"\n";
-  }
-  std::filesystem::permissions(exe, std::filesystem::perms::owner_all);
-  PrintConfig c;
-  const EngineParams e = prusaslicer(exe.string());
-  const TriangleMesh mesh = squeezed_saddle(c);
-  EngineRun normalised;
-  normalised.resolution = 0.01;
-  auto read_log = [&] {
-    std::ifstream in(log);
-    std::string text((std::istreambuf_iterator<char>(in)), {});
-    std::filesystem::remove(log);
-    return text;
-  };
-  EarlyEnginePtr early = start_engine_early(e, c, test::placed(test::saddle(), c));
-  ASSERT_NE(early, nullptr);
-  auto piped = run_engine(e, mesh, c, {}, normalised, early.get());
-  ASSERT_TRUE(piped) << piped.error().message;
-  std::string text = read_log();
-  EXPECT_NE(text.find("\nresolution = 0.01\n"), std::string::npos) << text;
-  auto late = run_engine(e, mesh, c, {}, normalised);
-  ASSERT_TRUE(late) << late.error().message;
-  text = read_log();
-  EXPECT_NE(text.find(" --resolution 0.01 "), std::string::npos) << text;
-  expect_same_print(*piped, *late);
-  auto own = run_engine(e, mesh, c, {});
-  ASSERT_TRUE(own) << own.error().message;
-  text = read_log();
-  EXPECT_EQ(text.find("resolution"), std::string::npos) << text;
 }
 
 TEST(EnginePrusaSlicer, NoEarlyEngineForAMeshPrusaSlicerWouldRepair) {
