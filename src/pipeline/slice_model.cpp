@@ -524,8 +524,10 @@ Expected<std::optional<SliceResult>> shell_before_stacks(
                     curved, area);
       return std::string(buf);
     };
-    auto shell = try_shells(mesh, job, pre.analysis, std::move(shells), why, 2 * area, stacked,
-                            ahead ? nullptr : pre.engine.get(), ctx);
+    // The early engine, unless the stacks' run (still going) may take it.
+    EarlyEngine* early = ahead && ahead->running() ? nullptr : pre.engine.get();
+    auto shell =
+        try_shells(mesh, job, pre.analysis, std::move(shells), why, 2 * area, stacked, early, ctx);
     if (!shell || *shell) return shell;
   }
   // The plans go before the stacks are mapped back, and the idle plan's thread had an
