@@ -465,7 +465,6 @@ Notice dropped_notice(const SliceResult& r, int patch, const std::string& why,
   return n;
 }
 
-// slice_model's rounds: attempts, retries without the patches that broke a limit, shells.
 // shells_for while `engine` runs: at idle priority, so as not to slow the engine's run (the
 // plan is needed only once it is done; PrusaSlicer slices on both cores at first), unless the
 // run is done first (the machine busy with other work, or a short run): then planned again at
@@ -546,6 +545,7 @@ Expected<std::optional<SliceResult>> shell_before_stacks(
   return std::optional<SliceResult>{};
 }
 
+// slice_model's rounds: attempts, retries without the patches that broke a limit, shells.
 Expected<SliceResult> slice_rounds(const TriangleMesh& mesh, const SliceJob& job,
                                    const Context& ctx) {
   Prepared pre;
