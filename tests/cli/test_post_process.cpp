@@ -11,16 +11,15 @@
 #include "core/sanitizers.hpp"
 #include "nonplanar/io.hpp"
 #include "support/cli.hpp"
+#include "support/engine_print.hpp"
 #include "support/solids.hpp"
 
 namespace nonplanar {
 namespace {
 
-namespace fs = std::filesystem;
+using test::have_prusaslicer;
 
-bool have_prusaslicer() {
-  return std::system("command -v prusa-slicer >/dev/null 2>&1") == 0;
-}
+namespace fs = std::filesystem;
 
 // prusa-slicer ARGS; its exit code, and its log in *log.
 int prusa(const std::string& args, std::string* log = nullptr) {

@@ -26,12 +26,9 @@ namespace nonplanar {
 namespace {
 
 using test::expect_same_print;
+using test::have_prusaslicer;
 using test::Made;
 using test::made;
-
-bool have_prusaslicer() {
-  return std::system("command -v prusa-slicer >/dev/null 2>&1") == 0;
-}
 
 TEST(EnginePrusaSlicer, SaddleMeetsTheBuiltInEnginesFigures) {
   if (!have_prusaslicer()) GTEST_SKIP() << "prusa-slicer not installed";

@@ -3,11 +3,9 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
-#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -19,11 +17,9 @@
 namespace nonplanar {
 namespace {
 
-namespace fs = std::filesystem;
+using test::have_prusaslicer;
 
-bool have_prusaslicer() {
-  return std::system("command -v prusa-slicer >/dev/null 2>&1") == 0;
-}
+namespace fs = std::filesystem;
 
 // The rib and the small domed tower through PrusaSlicer: the tower's stack covers too little,
 // so a shell over both is planned first, and refused (the tower stands above the rib: one run

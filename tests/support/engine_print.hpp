@@ -1,15 +1,21 @@
-// What a program from PrusaSlicer prints, as far as its runs repeat themselves (tests of the
-// engine route).
+// Tests of the engine route: whether PrusaSlicer is installed, and what a program from it
+// prints, as far as its runs repeat themselves.
 #pragma once
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <sstream>
 #include <string>
 #include <vector>
 
 namespace nonplanar::test {
+
+/// Whether prusa-slicer is on PATH (scripts/test.sh installs it; tests skip without it).
+inline bool have_prusaslicer() {
+  return std::system("command -v prusa-slicer >/dev/null 2>&1") == 0;
+}
 
 // What two runs of PrusaSlicer on one mesh agree on (it is not byte for byte the same from run
 // to run: its threads): the layers' heights, the filament and the box of what it extrudes.
