@@ -124,6 +124,7 @@ int run(const SliceOptions& o) {
   SliceJob job = make_job(cfg, o.max_angle);
   job.planar_only = o.planar;
   job.engine = engine;
+  job.keep_paths = false;  // the file is written from the text
   job.header.push_back("model: " + o.mesh.model);
   {  // where check and preview find the part, whatever printer the file was sliced for
     char buf[120];

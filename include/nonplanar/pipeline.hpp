@@ -69,6 +69,10 @@ struct SliceJob {
   /// built-in engine prints each layer object by object, labelled with print.gcode's
   /// objects. Empty: one object.
   std::vector<ObjectOutline> objects;
+  /// Keep SliceResult::layers' paths once the program is written from them. false: each
+  /// layer keeps its z and height, and its paths go before the safety gate's collision
+  /// search, for a caller that needs only the G-code (the CLI: the bunny's peak 172 → 158 MB).
+  bool keep_paths = true;
 };
 
 /// A job whose layer and check settings agree with the print configuration: heights, the
@@ -90,6 +94,9 @@ struct SliceResult {
   PrintStats stats;        ///< time and filament of `gcode` (with_print_stats)
   /// `gcode` carries them already: the gate measured them beside its collision search.
   bool stats_in_gcode = false;
+  /// The layers hold their z and height only: their paths went once `gcode` was written from
+  /// them (SliceJob::keep_paths false).
+  bool paths_released = false;
   /// The whole program, as the safety gate checked it: the built-in writer's, or an external
   /// engine's (its start and end G-code and settings kept) mapped back. Write it with
   /// write_gcode_text.

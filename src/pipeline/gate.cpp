@@ -6,6 +6,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include <malloc.h>
+
 #include "core/huge_pages.hpp"
 #include "core/parallel.hpp"
 #include "nonplanar/check.hpp"
@@ -19,13 +21,21 @@ namespace nonplanar {
 // A part thinner than one extrusion, or an open sheet, slices to nothing: say so rather than
 // write G-code that only draws a skirt (a lone sloped triangle once gave exit 0, a header
 // claiming 274 core layers, and no extrusion).
-std::optional<Error> nothing_to_print(const SliceResult& r, const TriangleMesh& mesh) {
-  const bool prints = std::any_of(r.layers.begin(), r.layers.end(), [](const LayerToolpaths& L) {
+namespace {
+
+// Whether some layer extrudes more than the skirt.
+bool prints(const std::vector<LayerToolpaths>& layers) {
+  return std::any_of(layers.begin(), layers.end(), [](const LayerToolpaths& L) {
     return std::any_of(L.paths.begin(), L.paths.end(), [](const ExtrusionPath& p) {
       return p.role != ExtrusionRole::skirt && p.points.size() >= 2;
     });
   });
-  if (prints) return std::nullopt;
+}
+
+}  // namespace
+
+std::optional<Error> nothing_to_print(const SliceResult& r, const TriangleMesh& mesh) {
+  if (r.paths_released || prints(r.layers)) return std::nullopt;
   const BoundingBox b = bounding_box(mesh);
   char buf[240];
   std::snprintf(buf, sizeof buf,
@@ -138,6 +148,14 @@ Expected<bool> gate(SliceResult& r, const SliceJob& job, const layers::BandedFie
   GateZones zones = banded ? gate_zones(*banded, job.check.toolhead.reach()) : GateZones{};
   zones.find_last_layers(r.layers);
   const OutOfOrder late = banded ? OutOfOrder{} : out_of_order(r.layers);
+  // The paths are in the text now, which the rest reads: a caller that wants only the text
+  // has them go before the search's grids are built (a print of nothing keeps them, for
+  // nothing_to_print to say so).
+  if (!job.keep_paths && prints(r.layers)) {
+    for (LayerToolpaths& L : r.layers) std::vector<ExtrusionPath>().swap(L.paths);
+    r.paths_released = true;
+    malloc_trim(0);  // their many small blocks, for the grids' pages to reuse
+  }
   std::function<bool(const GcodeMove&)> keep;
   if (r.nonplanar)
     keep = [&](const GcodeMove& m) {

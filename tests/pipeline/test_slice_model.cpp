@@ -77,5 +77,30 @@ TEST(ShellBeforeStacks, ThroughAnEngineTheStacksRunThatWentAheadPrints) {
   test::expect_same_print(r->gcode, plain->gcode);
 }
 
+// A caller that wants only the G-code (the CLI) has the paths go once it is written: the
+// same program and layers, none of their paths.
+TEST(KeepPaths, WithoutThemTheProgramIsTheSame) {
+  PrintConfig c;
+  const TriangleMesh mesh = test::placed(test::rib_and_small_domed_tower(), c);
+  SliceJob job = make_job(c);
+  auto kept = slice_model(mesh, job, {});
+  job.keep_paths = false;
+  auto released = slice_model(mesh, job, {});
+  ASSERT_TRUE(kept) << kept.error().message;
+  ASSERT_TRUE(released) << released.error().message;
+  EXPECT_TRUE(kept->nonplanar);
+  EXPECT_FALSE(kept->paths_released);
+  EXPECT_TRUE(released->paths_released);
+  EXPECT_EQ(released->gcode, kept->gcode);
+  ASSERT_EQ(released->layers.size(), kept->layers.size());
+  std::size_t points = 0;
+  for (std::size_t i = 0; i < kept->layers.size(); ++i) {
+    EXPECT_EQ(released->layers[i].z, kept->layers[i].z);
+    EXPECT_TRUE(released->layers[i].paths.empty());
+    for (const ExtrusionPath& p : kept->layers[i].paths) points += p.points.size();
+  }
+  EXPECT_GT(points, 1000u);
+}
+
 }  // namespace
 }  // namespace nonplanar
