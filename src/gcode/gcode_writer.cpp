@@ -279,10 +279,16 @@ class LayerBuilder {
   void extrude(const Vec3& p, double de, double speed, double height) {
     check_on_bed(p, what);
     unretract();
-    if (fresh_ || layer.steps.empty() || layer.steps.back().kind != ProgramStep::Kind::extrusion)
-      layer.start(ProgramStep::Kind::extrusion, role_, width_), fresh_ = false;
+    const bool begins =
+        fresh_ || layer.steps.empty() || layer.steps.back().kind != ProgramStep::Kind::extrusion;
+    if (begins) layer.start(ProgramStep::Kind::extrusion, role_, width_), fresh_ = false;
+    // F is modal: written where a path's moves begin and where the speed changes, as
+    // PrusaSlicer does (on every move it was 4.3 MB of the bunny's 37 MB).
+    const double f = feed(speed);
     ProgramMove m;
-    m.to = p, m.xy = true, m.z = std::abs(p.z() - pos_.z()) > 1e-9, m.de = de, m.f = feed(speed);
+    m.to = p, m.xy = true, m.z = std::abs(p.z() - pos_.z()) > 1e-9, m.de = de;
+    m.f = begins || f != path_f_ ? f : kNoValue;
+    path_f_ = f;
     m.height = height;
     layer.move(m);
     printed_.lay(pos_, p);
@@ -325,6 +331,7 @@ class LayerBuilder {
   ExtrusionRole role_ = ExtrusionRole::perimeter;
   double width_ = 0;
   bool fresh_ = false;  ///< begin_path was called and nothing extruded since
+  double path_f_ = 0;   ///< the feed rate of the extrusion step's last move
 };
 
 }  // namespace

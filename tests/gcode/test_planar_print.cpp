@@ -77,6 +77,39 @@ TEST(PlanarPrint, ATravelClearsHigherMaterialLaidBefore) {
   EXPECT_EQ(find_collisions(*moves, check_params(c, 30), nullptr, {})->collisions, 0u);
 }
 
+// F is modal: an extrusion's feed rate is written where its path's moves begin and where its
+// speed changes, and every move of a path is printed at its path's speed.
+TEST(PlanarPrint, FeedRateIsWrittenWhereAPathBeginsOrItsSpeedChanges) {
+  PrintConfig c;
+  auto path = [](double y, double speed) {
+    ExtrusionPath p;
+    p.role = ExtrusionRole::perimeter, p.speed = speed;
+    for (int k = 0; k <= 4; ++k)
+      p.points.emplace_back(100 + 2 * k, y, 0.2), p.height.push_back(0.2);
+    return p;
+  };
+  std::vector<LayerToolpaths> layers(2);
+  layers[0].z = layers[0].max_z = 0.2;
+  layers[0].paths = {path(100, 15), path(102, 15)};
+  layers[1].z = layers[1].max_z = 0.4;
+  layers[1].paths = {path(100, 30), path(102, 45)};
+  for (ExtrusionPath& p : layers[1].paths)
+    for (Vec3& v : p.points) v.z() = 0.4;
+  auto text = make_gcode(layers, c, {"test"}, {});
+  ASSERT_TRUE(text) << text.error().message;
+  const GcodeProgram prog = read_gcode_program(*text);
+  std::vector<double> feeds, own;
+  for (const GcodeMove& m : prog.moves)
+    if (m.layer >= 0 && m.extruding() && m.type != "Skirt/Brim")
+      feeds.push_back(m.feed), own.push_back(m.f);
+  ASSERT_EQ(feeds.size(), 16u);
+  for (std::size_t k = 0; k < 16; ++k) {
+    const double speed = k < 8 ? 15 : k < 12 ? 30 : 45;
+    EXPECT_EQ(feeds[k], 60 * speed) << k;
+    EXPECT_EQ(std::isnan(own[k]), k % 4 != 0) << k;  // each path's first move only
+  }
+}
+
 TEST(PlanarPrint, CubeAtFullInfillExtrudesItsVolume) {
   PrintConfig c;
   c.paths.fill_density = 1.0;
