@@ -263,7 +263,7 @@ Expected<std::vector<LayerToolpaths>> shell_toolpaths(const TriangleMesh& mesh,
   // The shells first: their maps may refuse them (shell_normalize_params) before the core.
   for (const layers::ShellPlan& plan : plans) {
     R.push_back(plan.region.empty() ? std::vector<ExPolygon>{}
-                                    : layers::region_at_least(plan.region, 0));
+                                    : layers::region_at_least(plan.region.as_top(), 0));
     auto paths = shell_layers(mesh, plan, R.back(), print, ctx);
     if (!paths) return paths.error();
     shells.push_back(std::move(*paths));

@@ -90,8 +90,14 @@ void relax(std::vector<double>& mz, const std::vector<int>& ring, int nx, int ny
 }  // namespace
 
 double FacetedTop::height(double x, double y) const {
-  const auto [p, u, v] = locate(*this, x, y);
-  return (1 - u) * ((1 - v) * p[0] + v * p[1]) + u * ((1 - v) * p[ny] + v * p[ny + 1]);
+  return bilinear(h.data(), origin, cell, nx, ny, x, y);
+}
+
+FacetedTop NodeMask::as_top() const {
+  FacetedTop t;
+  t.origin = origin, t.cell = cell, t.nx = nx, t.ny = ny;
+  t.h.assign(in.begin(), in.end());
+  return t;
 }
 
 Vec2 FacetedTop::gradient(double x, double y) const {

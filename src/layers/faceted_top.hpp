@@ -16,11 +16,27 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <vector>
 
 #include "nonplanar/analysis.hpp"
 
 namespace nonplanar::layers {
+
+/// The bilinear interpolant at (x, y) of node values v (nx·ny ≥ 2·2, node (i, j) at index
+/// i·ny + j, at origin + (i, j)·cell), constant past the raster's edge. T: double heights, or
+/// NodeMask's ±1 bytes (the same arithmetic, so the same values as doubles would give).
+template <class T>
+double bilinear(const T* v, const Vec2& origin, double cell, int nx, int ny, double x, double y) {
+  const double fx = std::clamp((x - origin.x()) / cell, 0.0, nx - 1.0);
+  const double fy = std::clamp((y - origin.y()) / cell, 0.0, ny - 1.0);
+  const int i = std::clamp(static_cast<int>(std::floor(fx)), 0, nx - 2);
+  const int j = std::clamp(static_cast<int>(std::floor(fy)), 0, ny - 2);
+  const T* p = v + static_cast<std::size_t>(i) * ny + j;
+  const double u = fx - i, w = fy - j;
+  const double p0 = p[0], p1 = p[1], p2 = p[ny], p3 = p[ny + 1];
+  return (1 - u) * ((1 - w) * p0 + w * p1) + u * ((1 - w) * p2 + w * p3);
+}
 
 struct FacetedTop {
   Vec2 origin{0, 0};  ///< node (0, 0), mm
@@ -33,6 +49,20 @@ struct FacetedTop {
   double height(double x, double y) const;
   /// (∂H/∂x, ∂H/∂y) of the bilinear interpolant at (x, y).
   Vec2 gradient(double x, double y) const;
+};
+
+/// Inside (+1) or outside (−1) at each node of a raster, a byte a node: what a FacetedTop of
+/// those heights holds in eight (a shell's region R on the bunny's raster: 2 MB, not 16).
+struct NodeMask {
+  Vec2 origin{0, 0};  ///< node (0, 0), mm
+  double cell = 0.1;  ///< node spacing, mm
+  int nx = 0, ny = 0;
+  std::vector<signed char> in;  ///< nx·ny, +1 or −1 (node (i, j) at index i·ny + j)
+  bool empty() const { return in.empty(); }
+  /// The bilinear interpolant of the ±1 at (x, y) (>= 0: inside).
+  double value(double x, double y) const { return bilinear(in.data(), origin, cell, nx, ny, x, y); }
+  /// The same values as heights (for a contour of them; 8 bytes a node while it lives).
+  FacetedTop as_top() const;
 };
 
 /// Calls f(i, j, z) for every node (i, j) of t's raster (at t.origin + (i, j)·t.cell) inside

@@ -38,7 +38,7 @@ struct ShellPlan {
   std::string refused;       ///< why the part cannot be printed this way (empty: it can)
   /// Where the shell prints (shell_region.hpp): empty when the part stands nowhere above H,
   /// else +1 on R's nodes. Outside R the core prints every layer whole.
-  FacetedTop region;
+  NodeMask region;
   /// s on H's raster, mm (shell_region.hpp); empty: the shell after the whole core.
   FacetedTop slack;
   ShellLevels levels;   ///< g (shell_levels.hpp)
@@ -51,7 +51,7 @@ struct ShellPlan {
   /// shell's refusal, "a shell over patches 0, 1: …" (empty: it follows them all).
   std::string narrowed;
 
-  bool in_region(double x, double y) const { return region.empty() || region.height(x, y) >= 0; }
+  bool in_region(double x, double y) const { return region.empty() || region.value(x, y) >= 0; }
   /// τ (shell_region.hpp): the core's layers up to this height are printed before the shell's
   /// point (x, y, u); +inf: all of them.
   double slot_level(double x, double y, double u) const {

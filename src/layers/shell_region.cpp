@@ -242,9 +242,10 @@ ShellRegion shell_region(const TriangleMesh& mesh, const std::vector<char>& in_p
     for (std::size_t q = 0; q < grown.size(); ++q)
       if (!grown[q] && to_core[q] > half + 1e-9) grown[q] = 1, above[q] = kNarrow;
   }
-  std::vector<double> mask = huge_vector(grown.size(), 0.0);
-  for (std::size_t q = 0; q < grown.size(); ++q) mask[q] = grown[q] ? -1.0 : 1.0;
-  out.mask = with_heights(top, std::move(mask));
+  out.mask.origin = top.origin, out.mask.cell = top.cell, out.mask.nx = top.nx;
+  out.mask.ny = top.ny;
+  out.mask.in.resize(grown.size());
+  for (std::size_t q = 0; q < grown.size(); ++q) out.mask.in[q] = grown[q] ? -1 : 1;
 
   // The patch's nodes: most of them must be in R.
   std::vector<char> patch_node(above.size(), 0);

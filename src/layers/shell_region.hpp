@@ -43,7 +43,7 @@ std::string notice_at(const char* what, const Vec3& p);
 struct ShellRegion {
   /// +1 at the nodes of R, −1 elsewhere, on H's raster (its marching-squares contour at 0 is
   /// R's outline); empty when R is the whole raster (nothing of the part stands above H).
-  FacetedTop mask;
+  NodeMask mask;
   /// s(p) on H's raster, mm; empty with an empty mask.
   FacetedTop slack;
   /// g: the heights most of the patch can be printed at (shell_levels.hpp); empty with an

@@ -129,5 +129,27 @@ TEST(TopSlopeBound, BoundsTheTopsChangeAndIsTightOnAPlane) {
   EXPECT_TRUE(std::isinf(layers::TopSlopeBound(plane).over({0, 0}, {1, 1})));
 }
 
+// A mask's value is what a FacetedTop of its ±1 gives, to the bit, inside the raster and past
+// its edge (a shell's region was such a raster of doubles).
+TEST(NodeMask, ValuesAreTheBilinearOfItsSigns) {
+  layers::NodeMask m;
+  m.origin = {3, -2}, m.cell = 0.13, m.nx = 37, m.ny = 23;
+  std::mt19937 rng(7);
+  for (int k = 0; k < m.nx * m.ny; ++k) m.in.push_back(rng() % 3 == 0 ? -1 : 1);
+  const layers::FacetedTop t = m.as_top();
+  ASSERT_EQ(t.h.size(), m.in.size());
+  std::uniform_real_distribution<double> x(2, 9), y(-3, 2);
+  int inside = 0, outside = 0;
+  for (int k = 0; k < 20000; ++k) {
+    const double px = x(rng), py = y(rng);
+    const double v = m.value(px, py);
+    ASSERT_EQ(v, t.height(px, py)) << px << ", " << py;
+    (v >= 0 ? inside : outside) += 1;
+  }
+  EXPECT_GT(inside, 1000);
+  EXPECT_GT(outside, 1000);
+  EXPECT_EQ(m.value(3, -2), m.in[0]);  // a node
+}
+
 }  // namespace
 }  // namespace nonplanar
