@@ -42,6 +42,9 @@ struct GateParams {
   /// The slope is judged over segments at least this long in XY, mm (a shorter one's slope is
   /// the rounding of its ends).
   double slope_run = 0.05;
+  /// The most moves near curved layers the gate holds in memory for its passes over them
+  /// (26 MB); past that each pass reads the program's text again.
+  std::size_t held_moves = 250000;
 };
 
 struct SliceJob {

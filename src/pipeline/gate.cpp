@@ -58,8 +58,8 @@ Expected<void> write_program(SliceResult& r, const SliceJob& job, const Context&
 
 namespace {
 
-// Most G lines of a program whose gate holds its moves in memory: 26 MB of PrintMove at most.
-constexpr std::size_t kHeldMoves = 250000;
+// Paths of more points than this (8 MB of them) are trimmed from the heap once let go.
+constexpr std::size_t kTrimPoints = 250000;
 
 // Whether a path is another slicer's support on a plane: printed as that slicer made it, on
 // layers of its own a contact distance apart (PrusaSlicer's beside a shell's core: 0.02 mm).
@@ -152,9 +152,16 @@ Expected<bool> gate(SliceResult& r, const SliceJob& job, const layers::BandedFie
   // has them go before the search's grids are built (a print of nothing keeps them, for
   // nothing_to_print to say so).
   if (!job.keep_paths && prints(r.layers)) {
-    for (LayerToolpaths& L : r.layers) std::vector<ExtrusionPath>().swap(L.paths);
+    std::size_t points = 0;
+    for (LayerToolpaths& L : r.layers) {
+      for (const ExtrusionPath& p : L.paths) points += p.points.size();
+      std::vector<ExtrusionPath>().swap(L.paths);
+    }
     r.paths_released = true;
-    malloc_trim(0);  // their many small blocks, for the grids' pages to reuse
+    // Their many small blocks back to the system, else the grids take new pages beside them
+    // (the bunny's peak: 171 MB untrimmed, 147 trimmed); on a small print the trim costs more
+    // than it gives (3 % of the sine roof's time, 48 000 points).
+    if (points > kTrimPoints) malloc_trim(0);
   }
   std::function<bool(const GcodeMove&)> keep;
   if (r.nonplanar)
@@ -162,20 +169,21 @@ Expected<bool> gate(SliceResult& r, const SliceJob& job, const layers::BandedFie
       return banded ? zones.may_matter(m, m.layer)
                     : late.may_matter(std::max(m.from.z(), m.to.z()), m.layer);
     };
-  // The moves that matter, held when the program is small, taken from the slopes' reading:
-  // the crossings and the collision search's two passes then read memory, not text (the gate
-  // read the sine roof's 2.4 MB five times, now twice; its collision search took 40 ms reading
-  // the text twice, about 32 held). Read from the text by each pass when it is large: the
-  // bunny's 690 000 kept moves would be 72 MB at its peak.
+  // The moves that matter, held when there are few, taken from the slopes' reading: the
+  // collision search's two passes then read memory, not text, and so do the crossings when
+  // the whole program is small (the gate read the sine roof's 2.4 MB five times, now twice; its
+  // collision search took 40 ms reading the text twice, about 32 held). Past the most it holds
+  // (GateParams::held_moves) each pass reads the text: the bunny's 690 000 would be 72 MB.
   const MoveReplay from_text = [&](const std::function<void(const PrintMove&)>& f) {
     for_each_print_move(r.gcode, keep, f);
   };
   std::vector<PrintMove> held;
-  const std::size_t g_lines = r.nonplanar ? count_gcode_lines(r.gcode).g_lines : 0;
-  const bool hold = r.nonplanar && g_lines <= kHeldMoves;
-  const MoveReplay moves = !hold ? from_text : [&](const std::function<void(const PrintMove&)>& f) {
+  bool holding = r.nonplanar;  // until more than held_moves are kept
+  const MoveReplay from_memory = [&](const std::function<void(const PrintMove&)>& f) {
     for (const PrintMove& m : held) f(m);
   };
+  const std::size_t g_lines = r.nonplanar ? count_gcode_lines(r.gcode).g_lines : 0;
+  const bool small = r.nonplanar && g_lines <= job.gate.held_moves;
   // The crossings on the other core while this one reads the slopes and searches for
   // collisions (on the bunny they took 0.7 s); then the file's time and filament
   // (with_print_stats' reading: 0.9 s on the bunny), kept when this program is the one
@@ -185,14 +193,19 @@ Expected<bool> gate(SliceResult& r, const SliceJob& job, const layers::BandedFie
   std::vector<Vec3> thin;
   PrintStatsStamp stamp;
   core::Background beside;
-  auto cross = [&] { crossings(r, job.layers, job.gate, moves, abandon, thin); };
-  if (!hold) beside.run(cross);
+  auto cross = [&] {
+    crossings(r, job.layers, job.gate, small ? from_memory : from_text, abandon, thin);
+  };
+  if (!small) beside.run(cross);
   if (r.nonplanar) beside.run([&] { stamp = measure_print_stats(r.gcode, job.print); });
   std::function<void(const GcodeMove&)> hold_move;
-  if (hold) {
-    reserve_huge(held, g_lines);
+  if (holding) {
+    reserve_huge(held, std::min(g_lines, job.gate.held_moves));
     hold_move = [&](const GcodeMove& m) {
-      if (!keep || keep(m)) held.push_back(print_move(m));
+      if (!holding || (keep && !keep(m))) return;
+      if (held.size() < job.gate.held_moves) return held.push_back(print_move(m));
+      holding = false;
+      std::vector<PrintMove>().swap(held);
     };
   }
   if (!slopes(r, job.layers, job.gate, violation, hold_move)) {
@@ -200,7 +213,7 @@ Expected<bool> gate(SliceResult& r, const SliceJob& job, const layers::BandedFie
     beside.wait();
     return false;
   }
-  if (hold) beside.run(cross);
+  if (small) beside.run(cross);
   auto thin_ones = [&] {
     for (const Vec3& p : thin)
       if (!violation(p, "a layer crosses the one under it thinner than h_min")) return false;
@@ -221,7 +234,7 @@ Expected<bool> gate(SliceResult& r, const SliceJob& job, const layers::BandedFie
                          [&](const BoundingBox& b) { return b.contains(p); });
     };
   if (!banded) looked_at = [&](const Vec3& p) { return late.looked_at(p); };
-  auto figures = find_collisions(moves, job.check, looked_at, ctx);
+  auto figures = find_collisions(holding ? from_memory : from_text, job.check, looked_at, ctx);
   beside.wait();
   if (!figures) return figures.error();
   if (!thin_ones()) return false;

@@ -115,6 +115,44 @@ TEST(Gate, FindsACollisionWithAShellPiecePrintedEarlierWithoutBands) {
   EXPECT_TRUE(run(160, &what)) << what;  // 40 mm away, beyond the heater block
 }
 
+// The gate's figures do not depend on where its passes read the moves: all held (a small
+// program), the few near the out-of-order heights held while the rest of a larger one is not,
+// or, past the most it holds, the text each time.
+TEST(Gate, SameFiguresWhereverItReadsTheMoves) {
+  for (const double core_x : {115.0, 160.0}) {
+    std::vector<std::string> verdicts;
+    std::vector<double> thickness;
+    for (const std::size_t most : {std::size_t(250000), std::size_t(60), std::size_t(3)}) {
+      SliceJob job = make_job(PrintConfig{});
+      job.gate.held_moves = most;
+      SliceResult r;
+      r.layers = ramp_then_core(core_x);
+      r.nonplanar = true;
+      std::string what = "passed";
+      auto ok =
+          gate(r, job, nullptr,
+               [&](const Vec3& p, const char* w) {
+                 char buf[160];
+                 std::snprintf(buf, sizeof buf, "%s at %.3f %.3f %.3f", w, p.x(), p.y(), p.z());
+                 what = buf;
+                 return false;
+               },
+               {});
+      ASSERT_TRUE(ok) << ok.error().message;
+      verdicts.push_back(what);
+      thickness.push_back(r.thickness_min), thickness.push_back(r.thickness_max);
+      if (most == 60) {  // more lines than that, fewer of them out of order
+        EXPECT_GT(count_gcode_lines(r.gcode).g_lines, most);
+      }
+    }
+    EXPECT_NE(verdicts[0].find(core_x < 150 ? "hit earlier layers" : "passed"), std::string::npos)
+        << verdicts[0];
+    for (std::size_t k = 1; k < verdicts.size(); ++k) EXPECT_EQ(verdicts[k], verdicts[0]) << k;
+    for (std::size_t k = 2; k < thickness.size(); ++k)
+      EXPECT_EQ(thickness[k], thickness[k % 2]) << k;
+  }
+}
+
 // A program as another slicer's route hands it over: the slope limit is judged on the lines
 // written, the print's own only. The user's start block and the skirt climb steeply and do not
 // count; a perimeter that climbs 2 mm over 4 mm (26.57°) is within 30°, one that climbs 2 mm
