@@ -18,10 +18,10 @@
 
 namespace nonplanar {
 
-// A part thinner than one extrusion, or an open sheet, slices to nothing: say so rather than
-// write G-code that only draws a skirt (a lone sloped triangle once gave exit 0, a header
-// claiming 274 core layers, and no extrusion).
 namespace {
+
+// Paths of more points than this (8 MB of them) are trimmed from the heap once let go.
+constexpr std::size_t kTrimPoints = 250000;
 
 // Whether some layer extrudes more than the skirt.
 bool prints(const std::vector<LayerToolpaths>& layers) {
@@ -32,8 +32,26 @@ bool prints(const std::vector<LayerToolpaths>& layers) {
   });
 }
 
+// The layers' paths go, their z and height stay (SliceJob::keep_paths false): the text holds
+// them now, and the gate's search builds its grids next.
+void release_paths(SliceResult& r) {
+  std::size_t points = 0;
+  for (LayerToolpaths& L : r.layers) {
+    for (const ExtrusionPath& p : L.paths) points += p.points.size();
+    std::vector<ExtrusionPath>().swap(L.paths);
+  }
+  r.paths_released = true;
+  // Their many small blocks back to the system, else the grids take new pages beside them
+  // (the bunny's peak: 171 MB untrimmed, 147 trimmed); on a small print the trim costs more
+  // than it gives (3 % of the sine roof's time, 48 000 points).
+  if (points > kTrimPoints) malloc_trim(0);
+}
+
 }  // namespace
 
+// A part thinner than one extrusion, or an open sheet, slices to nothing: say so rather than
+// write G-code that only draws a skirt (a lone sloped triangle once gave exit 0, a header
+// claiming 274 core layers, and no extrusion).
 std::optional<Error> nothing_to_print(const SliceResult& r, const TriangleMesh& mesh) {
   if (r.paths_released || prints(r.layers)) return std::nullopt;
   const BoundingBox b = bounding_box(mesh);
@@ -57,9 +75,6 @@ Expected<void> write_program(SliceResult& r, const SliceJob& job, const Context&
 }
 
 namespace {
-
-// Paths of more points than this (8 MB of them) are trimmed from the heap once let go.
-constexpr std::size_t kTrimPoints = 250000;
 
 // Whether a path is another slicer's support on a plane: printed as that slicer made it, on
 // layers of its own a contact distance apart (PrusaSlicer's beside a shell's core: 0.02 mm).
@@ -148,21 +163,9 @@ Expected<bool> gate(SliceResult& r, const SliceJob& job, const layers::BandedFie
   GateZones zones = banded ? gate_zones(*banded, job.check.toolhead.reach()) : GateZones{};
   zones.find_last_layers(r.layers);
   const OutOfOrder late = banded ? OutOfOrder{} : out_of_order(r.layers);
-  // The paths are in the text now, which the rest reads: a caller that wants only the text
-  // has them go before the search's grids are built (a print of nothing keeps them, for
+  // A caller that wants only the text lets the paths go (a print of nothing keeps them, for
   // nothing_to_print to say so).
-  if (!job.keep_paths && prints(r.layers)) {
-    std::size_t points = 0;
-    for (LayerToolpaths& L : r.layers) {
-      for (const ExtrusionPath& p : L.paths) points += p.points.size();
-      std::vector<ExtrusionPath>().swap(L.paths);
-    }
-    r.paths_released = true;
-    // Their many small blocks back to the system, else the grids take new pages beside them
-    // (the bunny's peak: 171 MB untrimmed, 147 trimmed); on a small print the trim costs more
-    // than it gives (3 % of the sine roof's time, 48 000 points).
-    if (points > kTrimPoints) malloc_trim(0);
-  }
+  if (!job.keep_paths && prints(r.layers)) release_paths(r);
   std::function<bool(const GcodeMove&)> keep;
   if (r.nonplanar)
     keep = [&](const GcodeMove& m) {
