@@ -122,6 +122,9 @@ struct ForeignMapOptions {
   /// object on the plate than the one the field was planned for. Travels to them are still
   /// lifted over curved layers. Empty: every move is mapped.
   std::vector<char> planar_lines;
+  /// Without a clip, layers are mapped side by side this many at a time, then written (and
+  /// only their moves' paths are held).
+  std::size_t layers_at_once = 64;
 };
 
 /// Maps a planar G-code file (PrusaSlicer's or OrcaSlicer's, or ours) sliced from the

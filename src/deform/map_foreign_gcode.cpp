@@ -33,8 +33,6 @@ using Kind = GcodeLine::Kind;
 using program::GcodeText;
 using program::LayerWork;
 
-constexpr std::size_t kMappedAtOnce = 64;  ///< layers mapped side by side, then written
-
 // What carries over from one layer's writing to the next.
 struct Writing {
   Writing(GcodeText text, program::PrintedTop top) : w(std::move(text)), printed(std::move(top)) {}
@@ -195,7 +193,7 @@ void build_layer(const LayerWork& work, const LayerField& field, const MapBackPa
 // What the layers share while they are written in order.
 struct InOrder {
   GcodeProgram& prog;
-  std::vector<ExtrusionPath>& mapped;
+  program::MovePaths& mapped;
   const LayerField& field;
   const MapBackParams& params;
   const ForeignMapOptions& options;
@@ -204,6 +202,19 @@ struct InOrder {
   std::vector<char>& dropped;  ///< per layer: cut away whole
   std::size_t clip_samples = 0, points = 0;
 };
+
+// `mapped` holds the moves of lines [begin, end) (the read program's: passes add theirs after).
+void window_moves(const std::vector<GcodeLine>& lines, std::size_t begin, std::size_t end,
+                  program::MovePaths& mapped) {
+  std::size_t lo = 0, hi = 0;
+  for (std::size_t l = begin; l < end; ++l)
+    if (lines[l].kind == Kind::move) {
+      const auto m = static_cast<std::size_t>(lines[l].move);
+      if (lo == hi) lo = m;
+      hi = m + 1;
+    }
+  mapped.window(lo, hi);
+}
 
 // One layer: cut back under the shell (options.clip), mapped (unless `premapped`, its point
 // count from map_gcode_layers, says it is), top skins ordered, built as steps and written.
@@ -282,9 +293,7 @@ Expected<ForeignGcode> map_foreign_gcode(std::string_view text, const LayerField
   ForeignGcode out;
   out.layers.resize(prog.layer_height.size());
   Writing s(GcodeText(prog.at_print.relative_e, prog.at_print.e), printed_top_over(prog));
-  std::vector<ExtrusionPath> mapped;  // as much room as the moves (the passes add to both)
-  mapped.reserve(prog.moves.capacity());
-  mapped.resize(prog.moves.size());
+  program::MovePaths mapped(prog.moves.size());  // a window's moves, and those the passes add
   std::size_t i = 0;
   for (; i < prog.print_begin; ++i) s.w.raw(lines[i].raw);
   out.start = std::move(s.w.out);
@@ -311,11 +320,14 @@ Expected<ForeignGcode> map_foreign_gcode(std::string_view text, const LayerField
   // Nothing cut away: the layers are independent until their passes, and are mapped side by
   // side first (the bunny from PrusaSlicer, 1000 layers: map back 2.02 s -> 1.54 s), a window
   // of layers at a time, and a layer's mapped moves go once it is written (they were all held
-  // at once: the bunny's map back rose 200 MB over the rest of the slice's peak).
-  const std::size_t window = options.clip ? spans.size() : kMappedAtOnce;
+  // at once: the bunny's map back rose 200 MB over the rest of the slice's peak); `mapped`
+  // holds the window's moves only.
+  const std::size_t window =
+      options.clip ? spans.size() : std::max<std::size_t>(1, options.layers_at_once);
   InOrder o{prog, mapped, field, params, options, out, s, dropped};
   for (std::size_t k0 = 0; k0 < spans.size(); k0 += window) {
     const std::size_t k1 = std::min(spans.size(), k0 + window);
+    window_moves(lines, spans[k0].begin, spans[k1 - 1].end, mapped);
     std::vector<std::size_t> premapped;
     if (!options.clip)
       premapped = map_gcode_layers(

@@ -15,7 +15,7 @@ bool kept_planar(const std::vector<char>& planar_lines, const GcodeMove& m) {
 
 std::optional<Error> map_gcode_layer(std::span<const GcodeLine> lines,
                                      const std::vector<GcodeMove>& moves,
-                                     std::vector<ExtrusionPath>& mapped, const LayerField& field,
+                                     program::MovePaths& mapped, const LayerField& field,
                                      const MapBackParams& params,
                                      const std::vector<char>& planar_lines, LayerToolpaths& L,
                                      std::size_t& points) {
@@ -61,8 +61,8 @@ std::vector<GcodeLayerSpan> gcode_layer_spans(const GcodeProgram& prog) {
 std::vector<std::size_t> map_gcode_layers(std::span<const GcodeLine> lines,
                                           const std::vector<GcodeLayerSpan>& spans,
                                           const std::vector<GcodeMove>& moves,
-                                          std::vector<ExtrusionPath>& mapped,
-                                          const LayerField& field, const MapBackParams& params,
+                                          program::MovePaths& mapped, const LayerField& field,
+                                          const MapBackParams& params,
                                           const std::vector<char>& planar_lines,
                                           std::vector<LayerToolpaths>& layers, const Context& ctx) {
   std::vector<std::size_t> points(spans.size(), kFailed);

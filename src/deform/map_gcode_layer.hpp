@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "nonplanar/deform.hpp"
+#include "program/layer_passes.hpp"
 
 namespace nonplanar {
 
@@ -23,7 +24,7 @@ bool kept_planar(const std::vector<char>& planar_lines, const GcodeMove& m);
 /// it). points counts the mapped points on; past params.most_points, an error naming the line.
 std::optional<Error> map_gcode_layer(std::span<const GcodeLine> lines,
                                      const std::vector<GcodeMove>& moves,
-                                     std::vector<ExtrusionPath>& mapped, const LayerField& field,
+                                     program::MovePaths& mapped, const LayerField& field,
                                      const MapBackParams& params,
                                      const std::vector<char>& planar_lines, LayerToolpaths& L,
                                      std::size_t& points);
@@ -47,8 +48,8 @@ inline constexpr std::size_t kFailed = static_cast<std::size_t>(-1);
 std::vector<std::size_t> map_gcode_layers(std::span<const GcodeLine> lines,
                                           const std::vector<GcodeLayerSpan>& spans,
                                           const std::vector<GcodeMove>& moves,
-                                          std::vector<ExtrusionPath>& mapped,
-                                          const LayerField& field, const MapBackParams& params,
+                                          program::MovePaths& mapped, const LayerField& field,
+                                          const MapBackParams& params,
                                           const std::vector<char>& planar_lines,
                                           std::vector<LayerToolpaths>& layers, const Context& ctx);
 

@@ -120,19 +120,22 @@ class KeepAll final : public LayerClip {
   double margin(double, double, double) const override { return 1; }
 };
 
-// With nothing clipped the layers are mapped side by side before they are written; the file,
-// the gate's paths and a refusal past most_points (its line) are what mapping them one at a
-// time gives.
+// With nothing clipped the layers are mapped side by side before they are written, a window
+// of 7 layers at a time here (each window's moves' paths the only ones held); the file, the
+// gate's paths and a refusal past most_points (its line) are what mapping them one at a time
+// gives.
 TEST(MapForeignGcode, LayersMappedSideBySideWriteWhatOneAtATimeDoes) {
   const NormalisedSaddle saddle;
   const KeepAll keep_all;
-  ForeignMapOptions in_order;
+  ForeignMapOptions in_order, windows;
   in_order.clip = &keep_all;
-  auto a = map_foreign_gcode(saddle.planar, *saddle.plan.field, {}, {});
+  windows.layers_at_once = 7;
+  auto a = map_foreign_gcode(saddle.planar, *saddle.plan.field, {}, {}, windows);
   auto b = map_foreign_gcode(saddle.planar, *saddle.plan.field, {}, {}, in_order);
   ASSERT_TRUE(a && b);
   EXPECT_TRUE(a->text() == b->text());  // (not EXPECT_EQ: the whole file)
   ASSERT_EQ(a->layers.size(), b->layers.size());
+  ASSERT_GT(a->layers.size(), 3 * windows.layers_at_once);
   std::size_t points = 0;
   for (std::size_t i = 0; i < a->layers.size(); ++i) {
     ASSERT_EQ(a->layers[i].paths.size(), b->layers[i].paths.size());
@@ -144,7 +147,7 @@ TEST(MapForeignGcode, LayersMappedSideBySideWriteWhatOneAtATimeDoes) {
   ASSERT_GT(points, 4000u);
   MapBackParams few;
   few.most_points = points / 2;
-  auto c = map_foreign_gcode(saddle.planar, *saddle.plan.field, few, {});
+  auto c = map_foreign_gcode(saddle.planar, *saddle.plan.field, few, {}, windows);
   auto d = map_foreign_gcode(saddle.planar, *saddle.plan.field, few, {}, in_order);
   ASSERT_FALSE(c);
   ASSERT_FALSE(d);
