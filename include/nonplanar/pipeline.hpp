@@ -74,7 +74,8 @@ struct SliceJob {
   std::vector<ObjectOutline> objects;
   /// Keep SliceResult::layers' paths once the program is written from them. false: each
   /// layer keeps its z and height, and its paths go before the safety gate's collision
-  /// search, for a caller that needs only the G-code (the CLI: the bunny's peak 172 → 158 MB).
+  /// search, for a caller that needs only the G-code (the CLI: on the bunny that phase's peak
+  /// fell from 177 to about 100 MB).
   bool keep_paths = true;
 };
 

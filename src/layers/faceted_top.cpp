@@ -9,20 +9,6 @@
 namespace nonplanar::layers {
 namespace {
 
-// The raster cell around (x, y): its first node and the fractions (u, v) across it. H is
-// constant past the raster's edge.
-struct Cell {
-  const double* p;
-  double u, v;
-};
-Cell locate(const FacetedTop& t, double x, double y) {
-  const double fx = std::clamp((x - t.origin.x()) / t.cell, 0.0, t.nx - 1.0);
-  const double fy = std::clamp((y - t.origin.y()) / t.cell, 0.0, t.ny - 1.0);
-  const int i = std::clamp(static_cast<int>(std::floor(fx)), 0, t.nx - 2);
-  const int j = std::clamp(static_cast<int>(std::floor(fy)), 0, t.ny - 2);
-  return {&t.h[static_cast<std::size_t>(i) * t.ny + j], fx - i, fy - j};
-}
-
 // A patch triangle seen from above: which (x, y) it covers and its plane's height there.
 // l1, l2 are the barycentric coordinates of b and c; d is twice the signed XY area (0: a
 // vertical triangle, which covers nothing).
@@ -101,7 +87,8 @@ FacetedTop NodeMask::as_top() const {
 }
 
 Vec2 FacetedTop::gradient(double x, double y) const {
-  const auto [p, u, v] = locate(*this, x, y);
+  const auto [k, u, v] = raster_cell(origin, cell, nx, ny, x, y);
+  const double* p = &h[k];
   return {((1 - v) * (p[ny] - p[0]) + v * (p[ny + 1] - p[1])) / cell,
           ((1 - u) * (p[1] - p[0]) + u * (p[ny + 1] - p[ny])) / cell};
 }
@@ -127,7 +114,7 @@ TopSlopeBound::TopSlopeBound(const FacetedTop& t)
 
 double TopSlopeBound::over(const Vec2& lo, const Vec2& hi) const {
   if (max_.empty()) return std::numeric_limits<double>::infinity();
-  // The cells locate() would use for the box's corners, and every cell between.
+  // The cells raster_cell() would use for the box's corners, and every cell between.
   auto cell_of = [&](double v, double o, int n) {
     const double f = std::clamp((v - o) / cell_, 0.0, n - 1.0);
     return std::clamp(static_cast<int>(std::floor(f)), 0, n - 2);

@@ -23,18 +23,27 @@
 
 namespace nonplanar::layers {
 
-/// The bilinear interpolant at (x, y) of node values v (nx·ny ≥ 2·2, node (i, j) at index
-/// i·ny + j, at origin + (i, j)·cell), constant past the raster's edge. T: double heights, or
-/// NodeMask's ±1 bytes (the same arithmetic, so the same values as doubles would give).
-template <class T>
-double bilinear(const T* v, const Vec2& origin, double cell, int nx, int ny, double x, double y) {
+/// The raster cell around (x, y) on nodes spaced `cell` from `origin` (nx·ny ≥ 2·2, node
+/// (i, j) at index i·ny + j): its first node's index and the fractions (u, w) across it, held
+/// at the raster's edge (values are constant past it).
+struct RasterCell {
+  std::size_t index;
+  double u, w;
+};
+inline RasterCell raster_cell(const Vec2& origin, double cell, int nx, int ny, double x, double y) {
   const double fx = std::clamp((x - origin.x()) / cell, 0.0, nx - 1.0);
   const double fy = std::clamp((y - origin.y()) / cell, 0.0, ny - 1.0);
   const int i = std::clamp(static_cast<int>(std::floor(fx)), 0, nx - 2);
   const int j = std::clamp(static_cast<int>(std::floor(fy)), 0, ny - 2);
-  const T* p = v + static_cast<std::size_t>(i) * ny + j;
-  const double u = fx - i, w = fy - j;
-  const double p0 = p[0], p1 = p[1], p2 = p[ny], p3 = p[ny + 1];
+  return {static_cast<std::size_t>(i) * ny + j, fx - i, fy - j};
+}
+
+/// The bilinear interpolant at (x, y) of node values v on raster_cell's raster. T: double
+/// heights, or NodeMask's ±1 bytes (the same arithmetic, so the same values as doubles).
+template <class T>
+double bilinear(const T* v, const Vec2& origin, double cell, int nx, int ny, double x, double y) {
+  const auto [k, u, w] = raster_cell(origin, cell, nx, ny, x, y);
+  const double p0 = v[k], p1 = v[k + 1], p2 = v[k + ny], p3 = v[k + ny + 1];
   return (1 - u) * ((1 - w) * p0 + w * p1) + u * ((1 - w) * p2 + w * p3);
 }
 
