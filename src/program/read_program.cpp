@@ -5,6 +5,7 @@
 #include <cctype>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <optional>
 #include <string>
 
@@ -105,6 +106,13 @@ class Reader {
   GcodeState s_;
   double width_ = 0.45, h_ = 0.2;
   double bead_h_ = 0.2;  // the latest ;HEIGHT: in force (a support layer's, the part's after it)
+  // A bridge's or an overhang's thickness: bead_h_, but where the layer follows layers of
+  // supports alone (PrusaSlicer's, between the part's), its height over the part's last layer,
+  // not over the support's (its header's ;HEIGHT:): a layer whose first path was an overhang
+  // was read 0.06 mm thick.
+  double bridge_h_ = 0.2;
+  double part_z_ = std::numeric_limits<double>::quiet_NaN();  // the last layer the part printed in
+  bool layer_of_part_ = false, bridged_ = false, support_ = false;  // of the ;TYPE: in force
   bool wipe_ = false, layer_header_ = false;  // layer_header: ;LAYER_CHANGE seen, not ;HEIGHT:
   std::string_view type_;
   int layer_ = -1;
@@ -170,28 +178,36 @@ void Reader::read_line(std::size_t i, GcodeLine& item) {
 }
 
 void Reader::comment(std::string_view c, std::size_t semi, GcodeLine& item, bool in_print) {
-  if (c.rfind(";TYPE:", 0) == 0) type_ = c.substr(6);
+  if (c.rfind(";TYPE:", 0) == 0) {
+    type_ = c.substr(6);
+    bridged_ = bridged(type_);
+    support_ = type_.find("upport") != std::string_view::npos;
+  }
   if (c.rfind(";WIDTH:", 0) == 0)
     if (auto w = core::parse_double(c.substr(7)); w && *w > 0) width_ = *w;
   if (c.rfind(";WIPE_START", 0) == 0) wipe_ = true;
   if (c.rfind(";WIPE_END", 0) == 0) wipe_ = false;
   if (!in_print) return;
   if (c.rfind(";LAYER_CHANGE", 0) == 0) {
+    if (layer_of_part_ && layer_ >= 0) part_z_ = p_.layer_z[static_cast<std::size_t>(layer_)];
+    layer_of_part_ = false;
     ++layer_;
     p_.layer_height.push_back(h_);
     p_.layer_z.push_back(pos_.z() + h_);
-    bead_h_ = h_;  // a layer without its own ;HEIGHT: keeps the last layer's, not a bead's
+    bead_h_ = bridge_h_ = h_;  // a layer without its own ;HEIGHT: keeps the last layer's
     layer_header_ = true;
   }
   // The layer's thickness is the ;HEIGHT: of its header; later ones are a bead's (a bridge's
   // is the nozzle's diameter) and pass untouched.
   if (layer_header_ && semi == 0 && c.rfind(";HEIGHT:", 0) == 0) {
     if (auto v = core::parse_double(c.substr(8)); v && *v > 0) h_ = *v, p_.layer_height.back() = h_;
-    bead_h_ = h_;
+    bead_h_ = bridge_h_ = h_;
+    if (const double over_part = p_.layer_z.back() - part_z_; over_part > h_ + 1e-4)
+      bridge_h_ = over_part;
     item.kind = Kind::height_comment;
     layer_header_ = false;
-  } else if (semi == 0 && c.rfind(";HEIGHT:", 0) == 0 && !bridged(type_)) {
-    if (auto v = core::parse_double(c.substr(8)); v && *v > 0) bead_h_ = *v;
+  } else if (semi == 0 && c.rfind(";HEIGHT:", 0) == 0 && !bridged_) {
+    if (auto v = core::parse_double(c.substr(8)); v && *v > 0) bead_h_ = bridge_h_ = *v;
   }
   if (semi == 0 && c.rfind(";Z:", 0) == 0) {
     item.kind = Kind::z_comment;
@@ -305,7 +321,8 @@ void Reader::move(core::Tokenizer& tok, GcodeLine& item, bool in_print) {
     if (m.de > 0 && std::isnan(r.back_f)) r.back_f = m.f;
   }
   m.wipe = wipe_, m.type = type_, m.width = width_, m.layer = layer_;
-  m.height = bead_h_;
+  m.height = bridged_ ? bridge_h_ : bead_h_;
+  if (!support_ && m.extruding()) layer_of_part_ = true;
   item.kind = Kind::move;
   if (sink_) return (*sink_)(m);
   if (line_sink_) return void(last_ = m);

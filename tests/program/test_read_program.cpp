@@ -161,6 +161,32 @@ TEST(ReadProgram, EachBeadKeepsItsOwnThickness) {
   EXPECT_EQ(h, (std::vector<double>{0.296, 0.2, 0.2}));
 }
 
+// A layer of the part after one of supports alone whose first path is an overhang: the
+// header's ;HEIGHT: is the distance from the support's layer (0.06), and the overhang's own
+// is its bead's; its thickness is the part's, from its last layer (0.18), as the perimeter
+// after it says. Read 0.06 thick, it stopped a shell with supports on at the safety check.
+TEST(ReadProgram, AnOverhangAfterASupportLayerIsAsThickAsThePartsLayer) {
+  const std::string g =
+      "G1 Z2.04\n;LAYER_CHANGE\n;Z:2.04\n;HEIGHT:0.06\n;TYPE:Perimeter\n;HEIGHT:0.18\n"
+      "G1 X1 Y1 E1\n;LAYER_CHANGE\n;Z:2.16\n;HEIGHT:0.12\n;TYPE:Support material interface\n"
+      "G1 Z2.16\nG1 X2 Y1 E2\n;LAYER_CHANGE\n;Z:2.22\n;HEIGHT:0.06\nG1 Z2.22\n"
+      ";TYPE:Overhang perimeter\n;HEIGHT:0.4\nG1 X3 Y1 E3\n;TYPE:Perimeter\n;HEIGHT:0.18\n"
+      "G1 X4 Y1 E4\n;TYPE:Bridge infill\n;HEIGHT:0.4\nG1 X5 Y1 E5\n"
+      ";LAYER_CHANGE\n;Z:2.4\n;HEIGHT:0.18\nG1 Z2.4\n;TYPE:Overhang perimeter\nG1 X6 Y1 E6\n";
+  const GcodeProgram p = read_gcode_program(g);
+  ASSERT_TRUE(p.problems.empty());
+  std::vector<double> h;
+  for (const GcodeMove& m : p.moves)
+    if (m.extruding()) h.push_back(m.height);
+  ASSERT_EQ(h.size(), 6u);
+  EXPECT_DOUBLE_EQ(h[1], 0.12);   // the support's: its layer's (no ;HEIGHT: of its own)
+  EXPECT_NEAR(h[2], 0.18, 1e-9);  // the overhang: over the part's layer at 2.04
+  EXPECT_DOUBLE_EQ(h[3], 0.18);
+  EXPECT_DOUBLE_EQ(h[4], 0.18);  // a bridge after the perimeter: the thickness in force
+  EXPECT_DOUBLE_EQ(h[5], 0.18);  // no support layer between: the header's
+  EXPECT_DOUBLE_EQ(p.layer_height[2], 0.06);  // the layers' own heights are the headers'
+}
+
 TEST(GcodeText, WritesTheWordsAskedForAndKeepsE) {
   program::GcodeText abs(false, 1.0);
   ProgramMove m;
