@@ -226,7 +226,7 @@ void register_slice(CLI::App& app, std::function<int()>* run_fn) {
                 "(see 'preview')");
   cmd->add_option("--engine", o->engine,
                   "Planar engine for the normalised mesh: builtin, prusaslicer (PrusaSlicer 2.5+\n"
-                  "command line; a shell over a planar core takes two runs, stitched) or\n"
+                  "command line; a shell over a planar core: one run, split and stitched) or\n"
                   "orcaslicer (untested; no shells); its G-code is mapped back")
       ->capture_default_str();
   cmd->add_option("--engine-path", o->engine_path,

@@ -57,8 +57,12 @@ Expected<void> write_stl(const std::filesystem::path& file, const TriangleMesh& 
 /// text: no '<' or '&' in them), e.g. ("slic3r.layer_height_profile", "z;h;z;h;…"). For a
 /// reader that cannot seek (a pipe: PrusaSlicer reads an STL or 3MF with fseek, an .amf.xml
 /// front to back) that must also get a layer-height profile, which OBJ cannot carry.
+/// `support_blockers`: volumes of the object under which PrusaSlicer generates no supports
+/// (each a <volume> of its own, metadata slic3r.volume_type = SupportBlocker), their vertices
+/// among the mesh's; their collapsed faces are left out too, and not counted.
 std::string amf_text(const TriangleMesh& mesh, std::size_t* collapsed = nullptr,
-                     const std::vector<std::pair<std::string, std::string>>& metadata = {});
+                     const std::vector<std::pair<std::string, std::string>>& metadata = {},
+                     const std::vector<TriangleMesh>& support_blockers = {});
 
 /// A file stored beside the model in a 3MF package: its path in the package ("/Metadata/…")
 /// and its bytes.

@@ -23,8 +23,7 @@ struct EngineRoute {
   const LayerParams& layers;
   const MapBackParams& map_back;
   /// PrusaSlicer started before the mesh existed (start_engine_early): the first plain run of
-  /// a mesh where it expects one takes it, a shell's two runs stop it. Null: each run starts
-  /// its own.
+  /// a mesh where it expects one takes it (a shell's run too). Null: each run starts its own.
   EarlyEngine* early = nullptr;
 };
 
@@ -44,10 +43,11 @@ Expected<EngineOutput> slice_with(const TriangleMesh& to_slice, const LayerField
                                   const EngineRoute& route, const Context& ctx);
 
 /// The shell plans printed by the route's engine: the built-in core and shells
-/// (shell_toolpaths), or the external engine's two runs stitched into one program
-/// (shell_with_engine: one shell only). Errors: unsupported (the engine's core is off the
-/// plan's boundaries), those of the stages and the engine, cancelled. `stacks`: curved stacks
-/// in the core (shell_toolpaths' CoreStacks field), built-in engine only (else unsupported).
+/// (shell_toolpaths), or the external engine's run of the part with the shell's slab above it,
+/// split and stitched into one program (shell_with_engine: one shell only). Errors: unsupported
+/// (the engine's core is off the plan's boundaries), those of the stages and the engine, cancelled.
+/// `stacks`: curved stacks in the core (shell_toolpaths' CoreStacks field), built-in engine only
+/// (else unsupported).
 Expected<EngineOutput> shell_with(const TriangleMesh& mesh,
                                   const std::vector<layers::ShellPlan>& plans,
                                   const EngineRoute& route, const Context& ctx,

@@ -51,7 +51,7 @@ struct TempDir {
 
 // The engines' process groups while they run (each its own group, so that a terminal's Ctrl-C
 // reaches us, not them, and we stop each with everything it started), for
-// kill_running_engine(): a slot each, as a shell's two runs go side by side.
+// kill_running_engine(): a slot each (an early one may wait beside a run started late).
 constexpr int kEngineSlots = 4;
 std::atomic<pid_t> g_engine_group[kEngineSlots]{};
 
@@ -113,29 +113,19 @@ std::vector<std::string> engine_forced_settings(const EngineParams& e, const Pri
   return s;
 }
 
-// What the shell's slab run forces: no skirt, brim or supports (the slab rests on the core),
-// its first layer like the others.
-const std::pair<const char*, const char*> kSlab[] = {{"skirts", "0"},
-                                                     {"brim_width", "0"},
-                                                     {"support_material", "0"},
-                                                     {"first_layer_speed", "100%"},
-                                                     {"first_layer_extrusion_width", "0"},
-                                                     {"elefant_foot_compensation", "0"},
-                                                     {"disable_fan_first_layers", "0"},
-                                                     {"raft_layers", "0"}};
-
 std::vector<std::string> engine_shell_settings(double first_layer) {
-  std::string slab = "shell: sliced by a second run:";
-  for (const auto& [key, value] : kSlab) slab += std::string(" ") + key + " = " + value + ",";
-  slab.pop_back();
   return {
-      "core: its layer boundaries from a 3MF layer-height profile (flat floors land on them), "
-      "first_layer_height = " +
-          num(first_layer),
-      slab};
+      "core and shell: one run, its layer boundaries from a 3MF layer-height profile (the "
+      "core's, where flat floors land, then the shell's above them), first_layer_height = " +
+      num(first_layer)};
 }
 
 namespace {
+
+// The height of a run's layers past its layer tops (all of them, without tops).
+double run_layer_height(const PrintConfig& c, const EngineRun& run) {
+  return run.layer_height > 0 ? run.layer_height : c.slice.layer_height;
+}
 
 // Pairs (z, height) PrusaSlicer interpolates linearly, looked up a little above each layer's
 // bottom; each layer gets two equal points (its bottom and middle), so its height is exact.
@@ -239,11 +229,6 @@ Expected<std::vector<std::string>> engine_args(const EngineParams& e, const Prin
   // does not know (arc_fitting, 2.6+) is ignored rather than fatal. What is on the command
   // line below overrides both.
   const fs::path forced = l.dir.path / "forced.ini";
-  auto forced_for_slab = [&](const std::string& key) {
-    return run.slab_layer_height > 0 &&
-           std::any_of(std::begin(kSlab), std::end(kSlab),
-                       [&](const auto& kv) { return key == kv.first; });
-  };
   {
     std::ofstream ini(forced);
     // A key once, with its last value: presets by name and --set may both give it, and
@@ -253,17 +238,15 @@ Expected<std::vector<std::string>> engine_args(const EngineParams& e, const Prin
     for (std::size_t i = 0; i < e.overrides.size(); ++i) {
       const auto& [key, value] = e.overrides[i];
       if (last[key] == i && key != "retract_lift" && key != "spiral_vase" && key != "arc_fitting" &&
-          key != "layer_height" && key != "first_layer_height" && !forced_for_slab(key))
+          key != "layer_height" && key != "first_layer_height")
         ini << key << " = " << value << "\n";
     }
     ini << "arc_fitting = disabled\n";
-    if (run.slab_layer_height > 0)
-      for (const auto& [key, value] : kSlab) ini << key << " = " << value << "\n";
     if (!ini) return Error{Status::io_error, "engine: cannot write " + forced.string()};
   }
   args.push_back("--export-gcode");
   if (!e.config.empty()) args.insert(args.end(), {"--load", e.config});
-  const double h = run.slab_layer_height > 0 ? run.slab_layer_height : c.slice.layer_height;
+  const double h = run_layer_height(c, run);
   args.insert(args.end(), {"--load", forced.string()});
   if (!l.settings.empty())
     args.insert(args.end(), {"--load", l.settings.string()});
@@ -325,7 +308,7 @@ bool exited(Launch& l) {
 // The layer heights of a run whose engine reads them from l.settings (the --layer-height and
 // --first-layer-height engine_args gives a run started late).
 std::string run_settings(const PrintConfig& c, const EngineRun& run, double first_layer) {
-  const double h = run.slab_layer_height > 0 ? run.slab_layer_height : c.slice.layer_height;
+  const double h = run_layer_height(c, run);
   return "layer_height = " + num(h) + "\nfirst_layer_height = " + num(first_layer) + "\n";
 }
 
@@ -483,10 +466,10 @@ std::optional<Expected<std::string>> run_early(EarlyEngine& early, const EngineP
   std::size_t collapsed = 0;
   std::vector<std::pair<std::string, std::string>> metadata;
   if (!run.layer_tops.empty())
-    metadata.emplace_back(
-        "slic3r.layer_height_profile",
-        layer_height_pairs(run_tops(box, run), c.slice.layer_height, box.max.z() - box.min.z()));
-  std::string amf = amf_text(mesh, &collapsed, metadata);
+    metadata.emplace_back("slic3r.layer_height_profile",
+                          layer_height_pairs(run_tops(box, run), run_layer_height(c, run),
+                                             box.max.z() - box.min.z()));
+  std::string amf = amf_text(mesh, &collapsed, metadata, run.support_blockers);
   if (collapsed != 0) return std::nullopt;
   Launch& l = early.launch;
   l.waiting = false;
@@ -505,13 +488,8 @@ Expected<std::string> run_engine(const EngineParams& e, const TriangleMesh& mesh
   // Where the part is: the engine centres its box there.
   const Vec2 centre = 0.5 * (box.min + box.max).head<2>();
   const bool profile = !orca && !run.layer_tops.empty();
-  const double h1 = run.slab_layer_height > 0 ? run.slab_layer_height
-                    : profile                 ? run.layer_tops.front() - box.min.z()
-                                              : c.slice.first_layer_height;
-  // A plain run or one with a profile (a shell's core) takes the engine started early; a slab
-  // is centred elsewhere and changes more settings than the layers' heights.
-  if (early && !orca && run.slab_layer_height <= 0 && centre == early->centre &&
-      !early->taken.exchange(true))
+  const double h1 = profile ? run.layer_tops.front() - box.min.z() : c.slice.first_layer_height;
+  if (early && !orca && centre == early->centre && !early->taken.exchange(true))
     if (auto gcode = run_early(*early, e, mesh, box, c, ctx, run, h1))
       // A pipe that could not be written, or a PrusaSlicer that failed (one whose readers seek
       // in an ini or AMF too, or a bad profile): run again as before, from files; the user
@@ -520,10 +498,12 @@ Expected<std::string> run_engine(const EngineParams& e, const TriangleMesh& mesh
   Launch l(profile ? "core.3mf" : "normalized.stl");
   if (l.dir.path.empty()) return Error{Status::io_error, "engine: cannot make a temporary folder"};
   if (profile) {
-    const PackageFile f{
-        "/Metadata/Slic3r_PE_layer_heights_profile.txt",
-        layer_height_profile(run_tops(box, run), c.slice.layer_height, box.max.z() - box.min.z())};
-    if (auto w = write_3mf(l.input, mesh, {f}); !w) return w.error();
+    const PackageFile f{"/Metadata/Slic3r_PE_layer_heights_profile.txt",
+                        layer_height_profile(run_tops(box, run), run_layer_height(c, run),
+                                             box.max.z() - box.min.z())};
+    Object3mf object;
+    object.support_blockers = run.support_blockers;
+    if (auto w = write_3mf(l.input, mesh, {f}, object); !w) return w.error();
   } else if (auto w = write_stl(l.input, mesh); !w) {
     return w.error();
   }

@@ -24,10 +24,12 @@ struct EngineRun {
   /// layer-height profile; past the last, layers of layer_height up to the mesh's top. Empty:
   /// first_layer_height, then layer_height.
   std::vector<double> layer_tops;
-  /// > 0: a slab printed over earlier work (the shell), in layers of this height (mm): no
-  /// skirt or brim, and its first layer printed like the others (speed, width, fan, no
-  /// elephant-foot compensation).
-  double slab_layer_height = 0;
+  /// > 0: the height of the layers past the last of layer_tops (mm; a shell's slab's). 0: the
+  /// print's layer_height.
+  double layer_height = 0;
+  /// Volumes of the mesh's object under which the engine generates no supports (PrusaSlicer's
+  /// SupportBlocker), in the mesh's coordinates; given with layer_tops only (an AMF or 3MF).
+  std::vector<TriangleMesh> support_blockers;
 };
 
 /// PrusaSlicer's layer-height profile (Metadata/Slic3r_PE_layer_heights_profile.txt) of the
@@ -35,8 +37,8 @@ struct EngineRun {
 /// then `h` thick up to `top`. Each layer's height is exact (two equal points a layer).
 std::string layer_height_profile(const std::vector<double>& tops, double h, double top);
 
-/// The settings the shell route forces on its two runs (header lines); first_layer: the core's
-/// first layer height, mm.
+/// What the shell route asks of its run (header lines); first_layer: the core's first layer
+/// height, mm.
 std::vector<std::string> engine_shell_settings(double first_layer);
 
 /// A PrusaSlicer run started before its mesh exists: it loads its libraries and the profile
@@ -67,15 +69,14 @@ EarlyEnginePtr start_engine_early(const EngineParams& e, const PrintConfig& c,
 /// SIGKILL after 3 s). Errors: io_error (engine missing, failed: its last output line; a
 /// file without the statistics or config block a slicer writes after the last layer, i.e.
 /// truncated), cancelled. `early`: an engine start_engine_early started with the same e and c;
-/// a run that is not a slab (plain, or with layer tops) of a mesh centred where it expects
-/// takes it (once), else it is left alone; when it fails, the run starts its own from files,
-/// as without it.
+/// a run of a mesh centred where it expects takes it (once), else it is left alone; when it fails,
+/// the run starts its own from files, as without it.
 Expected<std::string> run_engine(const EngineParams& e, const TriangleMesh& mesh,
                                  const PrintConfig& c, const Context& ctx,
                                  const EngineRun& run = {}, EarlyEngine* early = nullptr);
 
-/// For a signal handler (async-signal-safe): SIGKILL the running engines' process groups (a
-/// shell's two runs go side by side, an early one may wait); each run_engine() then returns and
+/// For a signal handler (async-signal-safe): SIGKILL the running engines' process groups (an
+/// early one may wait); each run_engine() then returns and
 /// removes its folder. True if one ran.
 bool kill_running_engine();
 

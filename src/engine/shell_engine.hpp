@@ -1,5 +1,6 @@
 // A shell over a planar core (layers/shell_plan.hpp) printed by an external engine
-// (PrusaSlicer): two runs of it, stitched into one program.
+// (PrusaSlicer): one run of the part with the shell's slab above it, split and stitched into
+// one program.
 #pragma once
 
 #include <string>
@@ -21,13 +22,37 @@ struct EngineShell {
 /// points of an edge are computed from its ends in one order, so neighbours agree.
 TriangleMesh cut_below(const TriangleMesh& mesh, double z0);
 
+/// What one slicer run of a shell is given (prepare's 3MF, the engine route's run): the placed
+/// part, sliced on the core's boundaries z_0 … z_s, and above z_s the shell's slab (the part
+/// normalised by ShellField(plan, base), base = z_s + t, cut below z_s: its layers are the
+/// shell's, ζ = base + j·t). The layer z_s … z_s + t under the slab (the normalised part just
+/// under the shell's bottom) holds it up, so the slicer prints the slab's first layer as on a
+/// part, not as a bridge; the split drops it. The part's own top above z_s joins the slab's
+/// layers, which cover it (the core's layers above z_s are all cut away under the shell).
+/// Why not two objects: a slicer drops every object onto the bed and prints its first layer
+/// with first-layer settings.
+struct ShellStack {
+  TriangleMesh mesh;               ///< the part's faces, then the slab's (open along its cut)
+  std::vector<double> layer_tops;  ///< mm: z_1 … z_s, then z_s + t … z_s + (N + 1)·t
+  double base = 0;                 ///< mm: z_s + t, the ζ of the shell's lowest layer's bottom
+  /// A box from just above z_s over the top, 1 mm wider than the part all round: the slab's
+  /// underside floats over the part's top, and a slicer with supports on would support it
+  /// (on the rib: 53 min of columns against 35 without); it supports the part's own only.
+  TriangleMesh support_blocker;
+};
+
+/// Inputs: the placed mesh, an accepted plan with no region (the whole top). Output: the
+/// stack above. Errors: the normalisation's (a map that would fold); cancelled.
+Expected<ShellStack> shell_stack(const TriangleMesh& placed, const layers::ShellPlan& plan,
+                                 const Context& ctx);
+
 /// Inputs: the placed mesh, an accepted plan (plan.refused empty), the route (its engine is
-/// PrusaSlicer). Output: one program: the core run's start G-code and layers, each cut back to
-/// where z_k <= B + a (as shell_toolpaths), then the shell run's layers mapped onto the shell
-/// (entered from where the core ended, its retraction given back), then the core run's end
-/// G-code. The core run slices the mesh on the plan's layer boundaries (a 3MF layer-height
-/// profile); the shell run slices the normalised mesh above ζ = 0 as a slab (no skirt,
-/// first-layer settings neutral). Errors: those of the engine and the mapping; cancelled.
+/// PrusaSlicer). Output: one program: the run's start G-code and core layers, each cut back to
+/// where z_k <= B + a (as shell_toolpaths), then the layers above the core mapped onto the
+/// shell (entered from where the core ended, its retraction given back), then the run's end
+/// G-code. The run slices shell_stack's mesh on its layer tops (a layer-height profile), and
+/// its file is split as post-process splits a prepared shell's (shell_split.hpp). Errors:
+/// those of the engine, the split and the mapping; cancelled.
 Expected<EngineShell> shell_with_engine(const TriangleMesh& mesh, const layers::ShellPlan& plan,
                                         const EngineRoute& job, const Context& ctx);
 

@@ -46,78 +46,110 @@ struct FloatTripleHash {
   }
 };
 
-}  // namespace
+char* put(char* e, const char* s) {
+  while (*s) *e++ = *s++;
+  return e;
+}
 
-std::string amf_text(const TriangleMesh& mesh, std::size_t* collapsed,
-                     const std::vector<std::pair<std::string, std::string>>& metadata) {
-  if (collapsed) *collapsed = 0;
+// An AMF object's shared vertices and its volumes' triangles, as text.
+class AmfMesh {
+ public:
+  explicit AmfMesh(std::size_t vertices) {
+    index_.reserve(vertices);
+    vertices_.reserve(vertices * 100);
+  }
+  // The faces of m as triangles appended to `f`; those whose corners collapse to one point
+  // or an edge in float are left out and returned.
+  std::size_t add_faces(const TriangleMesh& m, std::string& f) {
+    std::size_t collapsed = 0;
+    for (const auto& face : m.faces) {
+      float c[3][3];
+      Key keys[3];
+      for (int k = 0; k < 3; ++k) keys[k] = key_of(m.vertices[face[k]], c[k]);
+      if (keys[0] == keys[1] || keys[1] == keys[2] || keys[0] == keys[2]) {
+        ++collapsed;
+        continue;
+      }
+      char buf[160];
+      char* e = put(buf, "<triangle>");
+      const char* tags[3][2] = {{"<v1>", "</v1>"}, {"<v2>", "</v2>"}, {"<v3>", "</v3>"}};
+      for (int k = 0; k < 3; ++k) {
+        e = put(e, tags[k][0]);
+        e = std::to_chars(e, buf + sizeof buf, id(keys[k], c[k])).ptr;
+        e = put(e, tags[k][1]);
+      }
+      e = put(e, "</triangle>\n");
+      f.append(buf, e);
+    }
+    return collapsed;
+  }
+  const std::string& vertices() const { return vertices_; }
+
+ private:
   // Keyed by the floats' bits: -0.0f and 0.0f stay two vertices, as an STL reader comparing
   // bytes keeps them.
   using Key = std::array<std::uint32_t, 3>;
-  std::unordered_map<Key, std::uint32_t, FloatTripleHash> index;
-  index.reserve(mesh.vertices.size());
-  std::string v, f;
-  v.reserve(mesh.vertices.size() * 100);
-  f.reserve(mesh.faces.size() * 56);
-  char buf[160];
-  auto key_of = [](const Vec3& p, float c[3]) {
+  static Key key_of(const Vec3& p, float c[3]) {
     Key key;
     for (int k = 0; k < 3; ++k) {
       c[k] = static_cast<float>(p[k]);
       std::memcpy(&key[static_cast<std::size_t>(k)], &c[k], 4);
     }
     return key;
-  };
-  auto put = [&](char* e, const char* s) {
-    while (*s) *e++ = *s++;
-    return e;
-  };
-  for (const auto& face : mesh.faces) {
-    float c[3][3];
-    Key keys[3];
-    for (int k = 0; k < 3; ++k) keys[k] = key_of(mesh.vertices[face[k]], c[k]);
-    if (keys[0] == keys[1] || keys[1] == keys[2] || keys[0] == keys[2]) {
-      if (collapsed) ++*collapsed;
-      continue;
-    }
-    std::uint32_t id[3];
-    for (int k = 0; k < 3; ++k) {
-      const auto [it, added] = index.emplace(keys[k], static_cast<std::uint32_t>(index.size()));
-      id[k] = it->second;
-      if (!added) continue;
-      // The float's own value as a double, in the fewest digits that read back as that
-      // double: a reader parsing to float or to double, then to float, gets the float.
-      const char* tags[3][2] = {{"<x>", "</x>"}, {"<y>", "</y>"}, {"<z>", "</z>"}};
-      char* e = put(buf, "<vertex><coordinates>");
-      for (int d = 0; d < 3; ++d) {
-        e = put(e, tags[d][0]);
-        e = std::to_chars(e, buf + sizeof buf, static_cast<double>(c[k][d])).ptr;
-        e = put(e, tags[d][1]);
-      }
-      e = put(e, "</coordinates></vertex>\n");
-      v.append(buf, e);
-    }
-    char* e = put(buf, "<triangle>");
-    const char* tags[3][2] = {{"<v1>", "</v1>"}, {"<v2>", "</v2>"}, {"<v3>", "</v3>"}};
-    for (int k = 0; k < 3; ++k) {
-      e = put(e, tags[k][0]);
-      e = std::to_chars(e, buf + sizeof buf, id[k]).ptr;
-      e = put(e, tags[k][1]);
-    }
-    e = put(e, "</triangle>\n");
-    f.append(buf, e);
   }
+  // The vertex's index, written the first time it is used.
+  std::uint32_t id(const Key& key, const float c[3]) {
+    const auto [it, added] = index_.emplace(key, static_cast<std::uint32_t>(index_.size()));
+    if (!added) return it->second;
+    // The float's own value as a double, in the fewest digits that read back as that
+    // double: a reader parsing to float or to double, then to float, gets the float.
+    const char* tags[3][2] = {{"<x>", "</x>"}, {"<y>", "</y>"}, {"<z>", "</z>"}};
+    char buf[160];
+    char* e = put(buf, "<vertex><coordinates>");
+    for (int d = 0; d < 3; ++d) {
+      e = put(e, tags[d][0]);
+      e = std::to_chars(e, buf + sizeof buf, static_cast<double>(c[d])).ptr;
+      e = put(e, tags[d][1]);
+    }
+    e = put(e, "</coordinates></vertex>\n");
+    vertices_.append(buf, e);
+    return it->second;
+  }
+  std::unordered_map<Key, std::uint32_t, FloatTripleHash> index_;
+  std::string vertices_;
+};
+
+}  // namespace
+
+std::string amf_text(const TriangleMesh& mesh, std::size_t* collapsed,
+                     const std::vector<std::pair<std::string, std::string>>& metadata,
+                     const std::vector<TriangleMesh>& support_blockers) {
+  AmfMesh amf(mesh.vertices.size());
+  std::vector<std::string> volumes(1 + support_blockers.size());
+  volumes[0].reserve(mesh.faces.size() * 56);
+  const std::size_t lost = amf.add_faces(mesh, volumes[0]);
+  if (collapsed) *collapsed = lost;  // the part's: a blocker's lost faces lose no material
+  for (std::size_t b = 0; b < support_blockers.size(); ++b)
+    amf.add_faces(support_blockers[b], volumes[b + 1]);
   std::string out =
       "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<amf unit=\"millimeter\">\n"
       "<object id=\"1\">\n";
   for (const auto& [type, value] : metadata)
     out += "<metadata type=\"" + type + "\">" + value + "</metadata>\n";
-  out.reserve(out.size() + v.size() + f.size() + 128);
+  std::size_t size = out.size() + amf.vertices().size() + 128 * volumes.size();
+  for (const std::string& f : volumes) size += f.size();
+  out.reserve(size);
   out += "<mesh>\n<vertices>\n";
-  out += v;
-  out += "</vertices>\n<volume>\n";
-  out += f;
-  out += "</volume>\n</mesh>\n</object>\n</amf>\n";
+  out += amf.vertices();
+  out += "</vertices>\n";
+  for (std::size_t k = 0; k < volumes.size(); ++k) {
+    out += "<volume>\n";
+    // PrusaSlicer's AMF reader: a volume's type from its metadata, before its triangles.
+    if (k > 0) out += "<metadata type=\"slic3r.volume_type\">SupportBlocker</metadata>\n";
+    out += volumes[k];
+    out += "</volume>\n";
+  }
+  out += "</mesh>\n</object>\n</amf>\n";
   return out;
 }
 

@@ -64,7 +64,7 @@ bool reaches(const Band& a, const Band& b) {
 // Layers through the blend zone of band `b` (0 < β < 1) where there is material: thickness
 // and slope. Returns a reason, or empty. Columns every 0.5 mm: at 1 mm a thin part (the
 // bunny's ear) left few neighbouring columns both in material, and a 30.3° blend there was
-// found only in the final paths, after a whole slice (through PrusaSlicer, a second run).
+// found only in the final paths, after a whole slice (through PrusaSlicer, a run more).
 std::string check_blend(const BandedField& field, const Band& b, const ColumnCaster& columns,
                         const LayerParams& p) {
   const double step = 0.5;

@@ -10,13 +10,13 @@
 #include "core/huge_pages.hpp"
 #include "core/polygon_ops.hpp"
 #include "engine/shell_engine.hpp"
+#include "engine/shell_split.hpp"
 #include "layers/shell_plan.hpp"
 #include "nonplanar/config.hpp"
 #include "nonplanar/field_io.hpp"
 #include "nonplanar/print_plan.hpp"
 #include "nonplanar/program.hpp"
 #include "pipeline/gate.hpp"
-#include "pipeline/shell_split.hpp"
 
 namespace nonplanar {
 
@@ -372,7 +372,9 @@ Expected<Checked> checked_placement(std::string_view gcode, const std::string& b
   Checked c;
   c.moved = *moved;
   if (!plan.shell.empty()) {
-    auto split = shell_split(prog, gcode, *owner, plan);
+    auto shell = layers::parse_shell_plan_json(plan.shell);
+    if (!shell) return shell.error();
+    auto split = shell_split(prog, gcode, std::move(*owner), std::move(*shell));
     if (!split) return split.error();
     c.split = std::move(*split);
     return c;
@@ -385,7 +387,7 @@ Expected<Checked> checked_placement(std::string_view gcode, const std::string& b
   return c;
 }
 
-// A shell plan's G-code mapped as the engine route maps its two runs: the core (the file
+// A shell plan's G-code mapped as the engine route maps its run: the core (the file
 // without the shell's layers and the layer under them; other objects as written) cut back
 // under the shell; the shell's layers mapped onto the shell; joined.
 Expected<EngineShell> map_shell_gcode(ShellSplit& sp, const Vec2& moved, const SliceJob& job,

@@ -38,30 +38,8 @@ void set_limits(PrintPlan& p, const SliceJob& job, const SliceResult& r) {
   p.header = r.header;
 }
 
-// The box from just above z_s (the slab's first layer is sliced at z_s + t/2, the core's last
-// below z_s) to over the top, 1 mm wider than the part: a support blocker there leaves the
-// slicer nothing to support under the slab, whose underside floats over the part's top in the
-// 3MF (on the rib, supports on printed 53 min of columns against 35 without).
-TriangleMesh slab_blocker(const BoundingBox& part, double z_s) {
-  const Vec3 lo(part.min.x() - 1, part.min.y() - 1, z_s + 0.01);
-  const Vec3 hi(part.max.x() + 1, part.max.y() + 1, part.max.z() + 1);
-  TriangleMesh m;
-  for (int k = 0; k < 8; ++k)
-    m.vertices.emplace_back(k & 1 ? hi.x() : lo.x(), k & 2 ? hi.y() : lo.y(),
-                            k & 4 ? hi.z() : lo.z());
-  m.faces = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
-             {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
-  return m;
-}
-
-// The shell slice_model printed, for one slicer run: the part as it is, sliced on the core's
-// boundaries z_0 … z_s, and above z_s the shell's slab (its normalised layers, ζ = z_s + t + j·t
-// … , from ShellField with that base). One layer more under the slab (z_s … z_s + t, the
-// normalised part just under the shell's bottom) holds it up, so the slicer prints the slab's
-// first layer as it would on the core, not as a bridge over air; post-process cuts that layer
-// away. The part's own top above z_s joins the slab's layers there, which cover it (the
-// core's layers above z_s are all cut away under the shell). Why not two objects: a slicer
-// drops every object onto the bed and prints its first layer with first-layer settings.
+// The shell slice_model printed, as one slicer run takes it (engine/shell_engine.hpp's
+// ShellStack), with the plan post-process splits its G-code by.
 Expected<PreparedPart> prepare_shell(const TriangleMesh& placed, const SliceJob& job,
                                      SliceResult& r, const Context& ctx) {
   auto a = analyze(placed, job.analysis, ctx);
@@ -70,23 +48,14 @@ Expected<PreparedPart> prepare_shell(const TriangleMesh& placed, const SliceJob&
   const layers::ShellPlan plan = layers::choose_shell(placed, *a, job.layers);
   if (!plan.refused.empty() || !plan.region.empty() || plan.core.size() < 2)
     return Error{Status::internal_error, "prepare: the shell planned is not the one sliced"};
-  const double z_s = plan.core.back(), base = z_s + plan.t;
-  const layers::ShellField field(plan, base);
-  auto normalized = normalize_mesh(placed, field, shell_normalize_params(placed), ctx);
-  if (!normalized) return normalized.error();
-  const TriangleMesh slab = cut_below(normalized->mesh, z_s);
+  const double z_s = plan.core.back();
+  auto stack = shell_stack(placed, plan, ctx);
+  if (!stack) return stack.error();
   PreparedPart out;
-  out.normalized = placed;
-  const int offset = static_cast<int>(out.normalized.vertices.size());
-  out.normalized.vertices.insert(out.normalized.vertices.end(), slab.vertices.begin(),
-                                 slab.vertices.end());
-  for (const auto& f : slab.faces)
-    out.normalized.faces.push_back({f[0] + offset, f[1] + offset, f[2] + offset});
-  std::vector<double> tops(plan.core.begin() + 1, plan.core.end());
-  for (int j = 1; j <= plan.N + 1; ++j) tops.push_back(z_s + j * plan.t);
+  out.normalized = std::move(stack->mesh);
   PrintPlan& p = out.plan;
   p.box = bounding_box(out.normalized);
-  out.layer_heights_profile = layer_height_profile(tops, plan.t, p.box.max.z());
+  out.layer_heights_profile = layer_height_profile(stack->layer_tops, plan.t, p.box.max.z());
   set_limits(p, job, r);
   // The core's layers are the plan's: its first is the slicer's first layer.
   p.first_layer_height = plan.core[1];
@@ -97,7 +66,7 @@ Expected<PreparedPart> prepare_shell(const TriangleMesh& placed, const SliceJob&
   p.shell = layers::shell_plan_json(plan);
   const double z2 = plan.core.size() > 2 ? plan.core[2] : z_s + plan.t;
   set_anchor(p, out.normalized, plan.core[1], z2, ctx);
-  out.support_blocker = slab_blocker(p.box, z_s);
+  out.support_blocker = std::move(stack->support_blocker);
   out.notices = std::move(r.notices);
   out.shell_layers = plan.N;
   return out;

@@ -190,7 +190,7 @@ std::vector<int> shell_patches(const std::vector<layers::ShellPlan>& shells) {
   return all;
 }
 
-// layers::choose_shells, one shell only through an external engine (its two runs take one)
+// layers::choose_shells, one shell only through an external engine (its one run takes one)
 // or for one slicer run (prepare); stopped when ctx is cancelled.
 std::vector<layers::ShellPlan> shells_for(const TriangleMesh& mesh, const Analysis& a,
                                           const SliceJob& job, const Context& ctx) {

@@ -1,5 +1,5 @@
 // Passes over one layer of a program being mapped onto curved layers, written once for every
-// route that maps G-code (another slicer's file, the shell's two runs, a post-processed file).
+// route that maps G-code (another slicer's file, a shell's core and slab, a post-processed file).
 #pragma once
 
 #include <cstddef>

@@ -476,7 +476,7 @@ TEST(PostProcessRoute, AShellPrintsAfterTheOtherObjectsOnThePlate) {
 // The slab stands above the part in the 3MF, and PrusaSlicer would support its underside
 // (columns from the part's top and from the bed beside it): prepare puts a support blocker
 // there, so supports on prints none for it. Without the blocker, post-process leaves out those
-// in the shell's layers (as the engine route's slab run has none) and the core's cut takes
+// in the shell's layers (as the engine route would) and the core's cut takes
 // those on the part where the shell goes; the shell prints as without them.
 TEST(PostProcessRoute, AShellPrintsNoSupportsUnderItsSlab) {
   if (!have_prusaslicer()) GTEST_SKIP() << "prusa-slicer not installed";

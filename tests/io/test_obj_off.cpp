@@ -154,6 +154,29 @@ TEST(AmfText, ReadsBackAsTheBinaryStlOfTheMesh) {
     }
 }
 
+// A support blocker is a volume of its own after the part's, its type in metadata before its
+// triangles (PrusaSlicer's AMF reader), its vertices among the object's.
+TEST(AmfText, ASupportBlockerIsAVolumeOfItsOwn) {
+  const TriangleMesh part = test::box({0, 0, 0}, {10, 10, 5});
+  const TriangleMesh blocker = test::box({-1, -1, 3}, {11, 11, 6});
+  std::size_t collapsed = 9;
+  const std::string text = amf_text(part, &collapsed, {}, {blocker});
+  EXPECT_EQ(collapsed, 0u);
+  const std::size_t second = text.find("<volume>", text.find("<volume>") + 1);
+  ASSERT_NE(second, std::string::npos);
+  EXPECT_EQ(text.find("<volume>", second + 1), std::string::npos);
+  EXPECT_EQ(text.find("<metadata type=\"slic3r.volume_type\">SupportBlocker</metadata>"),
+            second + 9);
+  const TriangleMesh back = read_amf_text(text);
+  EXPECT_EQ(back.faces.size(), part.faces.size() + blocker.faces.size());
+  EXPECT_EQ(back.vertices.size(), 16u);  // no corner shared
+  for (std::size_t f = part.faces.size(); f < back.faces.size(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      const Vec3& v = back.vertices[static_cast<std::size_t>(back.faces[f][k])];
+      EXPECT_TRUE(v.z() == 3 || v.z() == 6);
+    }
+}
+
 TEST(AmfText, FacesThatCollapseInFloatAreLeftOutAndCounted) {
   TriangleMesh m;
   m.vertices = {{0, 0, 0}, {10, 0, 0}, {0, 10, 0}, {10 + 1e-7, 0, 0}};  // 1 and 3: one float

@@ -1,5 +1,5 @@
 // shell_split (shell_split.hpp): a shell plan's G-code cut into its core and its shell.
-#include "pipeline/shell_split.hpp"
+#include "engine/shell_split.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -99,11 +99,10 @@ std::vector<char> support_lines(const GcodeProgram& prog, const std::vector<char
 }  // namespace
 
 Expected<ShellSplit> shell_split(const GcodeProgram& prog, std::string_view gcode,
-                                 const std::vector<char>& owner, const PrintPlan& plan) {
+                                 std::vector<char> owner, layers::ShellPlan plan) {
+  if (owner.empty()) owner.assign(prog.lines.size(), kOurs);
   ShellSplit out;
-  auto shell = layers::parse_shell_plan_json(plan.shell);
-  if (!shell) return shell.error();
-  out.plan = std::move(*shell);
+  out.plan = std::move(plan);
   const double z_s = out.plan.core.back(), t = out.plan.t;
   const LayerUse use = layer_use(prog, owner);
   auto plate = plate_layer(prog, use, z_s, t);

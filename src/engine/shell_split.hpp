@@ -9,7 +9,6 @@
 #include <vector>
 
 #include "layers/shell_plan.hpp"
-#include "nonplanar/print_plan.hpp"
 #include "nonplanar/program.hpp"
 
 namespace nonplanar {
@@ -31,15 +30,16 @@ struct ShellSplit {
   /// Whether other objects share the plate (they print with the core, the shell after them).
   bool shares_plate = false;
   /// Support extrusions the slicer put in the shell's layers (under the slab, which stands
-  /// above the part in the 3MF), left out as the engine route's slab run has none; mm of them.
+  /// above the part in the 3MF; a support blocker keeps them off), left out; mm of them.
   double supports_left_out = 0;
 };
 
-/// Inputs: the file read (`prog` from `gcode`), whose each line is (size = prog.lines), the
-/// plan. Output: the split; refused (invalid_argument, one line) when the part's layers above
-/// z_s are not the plan's (no layer ends at z_s + t, a shell layer off the t grid) or the
-/// shell's layers hold nothing but supports.
+/// Inputs: the file read (`prog` from `gcode`), whose each line is (size = prog.lines; empty:
+/// every line the part's), the shell's plan (where the part was placed). Output: the split;
+/// refused (invalid_argument, one line) when the part's layers above z_s are not the plan's
+/// (no layer ends at z_s + t, a shell layer off the t grid) or the shell's layers hold nothing
+/// but supports.
 Expected<ShellSplit> shell_split(const GcodeProgram& prog, std::string_view gcode,
-                                 const std::vector<char>& owner, const PrintPlan& plan);
+                                 std::vector<char> owner, layers::ShellPlan plan);
 
 }  // namespace nonplanar
