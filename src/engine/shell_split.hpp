@@ -1,7 +1,8 @@
-// Where a shell plan's G-code splits (prepare_shell in prepare_part.cpp): the planned part's
+// Where the G-code of a shell's stack splits (ShellStack in shell_engine.hpp: what prepare
+// writes for the user's slicer and the engine route gives PrusaSlicer): the planned part's
 // core, in layers with tops on the plan's boundaries up to z_s; its layer z_s … z_s + t that
-// held the shell's slab up in the 3MF (dropped); its shell's layers, t thick. Other objects on
-// the plate print with the core, as the slicer wrote them.
+// held the shell's slab up (dropped); its shell's layers, t thick. Other objects on the plate
+// print with the core, as the slicer wrote them.
 #pragma once
 
 #include <string>
@@ -18,7 +19,7 @@ namespace nonplanar {
 enum LineOwner : char { kUnlabelled = 0, kOurs = 1, kOthers = 2 };
 
 struct ShellSplit {
-  layers::ShellPlan plan;  ///< the plan's shell, where prepare placed the part
+  layers::ShellPlan plan;  ///< the plan's shell, where the part was placed
   /// The file without the planned part's lines above z_s (the layers only it prints there go
   /// whole), as a program of its own (program/splice_lines.hpp).
   std::string core;
