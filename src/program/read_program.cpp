@@ -181,7 +181,7 @@ void Reader::comment(std::string_view c, std::size_t semi, GcodeLine& item, bool
   if (c.rfind(";TYPE:", 0) == 0) {
     type_ = c.substr(6);
     bridged_ = bridged(type_);
-    support_ = type_.find("upport") != std::string_view::npos;
+    support_ = role_from_name(type_) == ExtrusionRole::support;
   }
   if (c.rfind(";WIDTH:", 0) == 0)
     if (auto w = core::parse_double(c.substr(7)); w && *w > 0) width_ = *w;
