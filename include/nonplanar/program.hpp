@@ -17,6 +17,7 @@
 #include "nonplanar/mesh.hpp"
 #include "nonplanar/polygon.hpp"
 #include "nonplanar/status.hpp"
+#include "nonplanar/toolhead.hpp"
 #include "nonplanar/toolpaths.hpp"
 
 namespace nonplanar {
@@ -228,6 +229,8 @@ struct LayerPassParams {
   std::size_t most_clip_samples = 50'000'000;
   /// A travel between two reordered top-skin strokes longer than this is retracted around.
   double skin_retract_over = 1.0;
+  /// The head, whose reach says which strokes of a top skin are ordered (low_to_high).
+  Toolhead head;
 };
 
 /// One G0/G1 move with what it deposited (check's input).

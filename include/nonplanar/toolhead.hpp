@@ -36,6 +36,10 @@ struct Toolhead {
 
   /// Farthest XY distance from the nozzle axis that any part of the head covers (mm).
   double reach() const;
+  /// The same for the parts of the head lower than `height` mm above the tip (the cone up to
+  /// there, the slices or block under it): material standing at most `height` over the tip
+  /// farther off than this touches nothing.
+  double reach_under(double height) const;
   /// Lowest height above the tip of anything but the nozzle cone (mm).
   double clearance() const;
   /// Where the nozzle cone meets the head above it (mm above the tip): the block_clearance of

@@ -68,6 +68,17 @@ double Toolhead::reach() const {
   return shape.empty() ? block_radius : shape_reach(*this, cone_top());
 }
 
+double Toolhead::reach_under(double height) const {
+  const double h = std::max(0.0, height);
+  if (shape.empty())
+    return h > block_clearance
+               ? std::max(block_radius, tip_radius + block_clearance / tan_deg(cone_angle_deg))
+               : tip_radius + h / tan_deg(cone_angle_deg);
+  Toolhead under = *this;
+  std::erase_if(under.shape, [&](const ToolheadSlice& s) { return s.height >= h; });
+  return shape_reach(under, std::min(cone_top(), h));
+}
+
 double Toolhead::clearance() const {
   if (shape.empty()) return block_clearance;
   double h = kInf;

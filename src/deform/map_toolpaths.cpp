@@ -150,7 +150,7 @@ bool is_top(const ExtrusionPath& p) {
 }
 
 // Each run of top-skin paths, in the order and direction the rule gives.
-void order_top_skins(std::vector<ExtrusionPath>& ps) {
+void order_top_skins(std::vector<ExtrusionPath>& ps, const Toolhead& head) {
   for (std::size_t s = 0; s < ps.size();) {
     if (!is_top(ps[s])) {
       ++s;
@@ -161,12 +161,13 @@ void order_top_skins(std::vector<ExtrusionPath>& ps) {
     std::vector<program::StrokeHeights> h;
     for (std::size_t k = s; k < e; ++k) {
       program::StrokeHeights sh;
-      for (const Vec3& v : ps[k].points) sh.mean += v.z();
+      for (const Vec3& v : ps[k].points) sh.mean += v.z(), sh.box.extend(v);
+      sh.box.width = ps[k].width;
       sh.mean /= static_cast<double>(ps[k].points.size());
       sh.first = ps[k].points.front().z(), sh.last = ps[k].points.back().z();
       h.push_back(sh);
     }
-    const program::LowToHigh order = program::low_to_high(h);
+    const program::LowToHigh order = program::low_to_high(h, head);
     std::vector<ExtrusionPath> run;
     for (std::size_t k : order.order) {
       run.push_back(std::move(ps[s + k]));
@@ -215,7 +216,7 @@ Expected<std::vector<LayerToolpaths>> map_toolpaths_back(const std::vector<Layer
     M.nonplanar = M.max_z - min_z > 1e-6;
     if (M.paths.empty()) M.max_z = L.z;
     // Top skins on a slope, low to high (program::low_to_high, DESIGN.md §3).
-    if (M.nonplanar) order_top_skins(M.paths);
+    if (M.nonplanar) order_top_skins(M.paths, params.passes.head);
   });
   if (stop) return Error{Status::cancelled, "cancelled"};
   return out;

@@ -10,6 +10,7 @@
 #include "core/polygon_ops.hpp"
 #include "layers/height_contour.hpp"
 #include "nonplanar/deform.hpp"
+#include "program/reach_groups.hpp"
 
 namespace nonplanar {
 namespace {
@@ -148,11 +149,15 @@ void split_by_slot(const ExtrusionPath& p, const layers::ShellPlan& plan,
 // level, the rest of the core after it (shell_region.hpp). Slot k holds, layer by layer in print
 // order, the pieces printed between core layers k − 1 and k (k = K: after the whole core).
 // With several shells, each one's pieces in a slot follow the one's before it (their patches
-// lie beyond the head's reach of each other's; the gate checks what they print).
+// lie beyond the head's reach of each other's; the gate checks what they print). The pieces of
+// a layer in a slot are printed group by group (program::order_reach_groups): a band beside a
+// wall is cut into pieces on all sides of the wall, and in the order of the layer's paths they
+// sent the nozzle round it between two pieces.
 std::vector<LayerToolpaths> interleave(std::vector<LayerToolpaths> core,
                                        const std::vector<double>& tops,
                                        const std::vector<std::vector<LayerToolpaths>>& shells,
-                                       const std::vector<layers::ShellPlan>& plans) {
+                                       const std::vector<layers::ShellPlan>& plans,
+                                       const Toolhead& head) {
   const std::size_t K = core.size();
   std::vector<std::vector<LayerToolpaths>> slots(K + 1);
   for (std::size_t i = 0; i < shells.size(); ++i)
@@ -180,14 +185,26 @@ std::vector<LayerToolpaths> interleave(std::vector<LayerToolpaths> core,
   // core layer under the highest shell point so far travels over it lifted.
   std::vector<LayerToolpaths> out;
   double shell_so_far = -1e300;
+  Vec2 at(0, 0);  // where the nozzle is, after the layers so far
+  auto last_point = [&](const LayerToolpaths& L) {
+    for (auto p = L.paths.rbegin(); p != L.paths.rend(); ++p)
+      if (!p->points.empty()) return at = p->points.back().head<2>(), void();
+  };
   for (std::size_t k = 0; k <= K; ++k) {
     for (LayerToolpaths& part : slots[k]) {
       part.z = part.max_z;
       shell_so_far = std::max(shell_so_far, part.max_z);
+      std::vector<ExtrusionPath> ordered;
+      ordered.reserve(part.paths.size());
+      for (std::size_t i : program::order_reach_groups(part.paths, head, at))
+        ordered.push_back(std::move(part.paths[i]));
+      part.paths = std::move(ordered);
+      last_point(part);
       out.push_back(std::move(part));
     }
     if (k == K) break;
     LayerToolpaths& L = core[k];
+    last_point(L);
     if (L.z < shell_so_far) L.nonplanar = true, L.max_z = std::max(L.max_z, shell_so_far);
     out.push_back(std::move(L));
   }
@@ -231,7 +248,9 @@ Expected<std::vector<LayerToolpaths>> shell_layers(const TriangleMesh& mesh,
   auto planar = make_toolpaths(*cut, tp, ctx);
   if (!planar) return planar.error();
   planar->erase(planar->begin());
-  auto mapped = map_toolpaths_back(*planar, field, {}, ctx);
+  MapBackParams back;  // the default chords, the printer's head for the top skins' order
+  back.passes.head = print.toolhead;
+  auto mapped = map_toolpaths_back(*planar, field, back, ctx);
   if (!mapped) return mapped.error();
   std::vector<LayerToolpaths> paths;
   for (std::size_t j = 0; j < mapped->size(); ++j) {
@@ -305,7 +324,7 @@ Expected<std::vector<LayerToolpaths>> shell_toolpaths(const TriangleMesh& mesh,
   }
   std::vector<double> tops;
   for (std::size_t k = 0; k < core_paths.size(); ++k) tops.push_back((*core)[k].z_top);
-  return interleave(std::move(core_paths), tops, shells, plans);
+  return interleave(std::move(core_paths), tops, shells, plans, print.toolhead);
 }
 
 }  // namespace nonplanar

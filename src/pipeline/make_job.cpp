@@ -40,6 +40,7 @@ SliceJob make_job(const PrintConfig& print, double max_angle_deg) {
   }
   j.layers.toolhead = print.toolhead;
   j.map_back.tip_radius = print.toolhead.tip_radius;
+  j.map_back.passes.head = print.toolhead;
   j.map_back.min_layer_height = j.layers.min_layer_height;
   j.map_back.travel_lift = travel_lift(print.gcode.retract_lift);
   j.check = check_params(print, j.layers.max_angle_deg);

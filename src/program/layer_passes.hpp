@@ -7,7 +7,9 @@
 #include <vector>
 
 #include "nonplanar/program.hpp"
+#include "nonplanar/toolhead.hpp"
 #include "nonplanar/toolpaths.hpp"
+#include "program/reach_groups.hpp"
 
 namespace nonplanar::program {
 
@@ -48,20 +50,22 @@ struct LayerWork {
   GcodeLine add(GcodeMove m, ExtrusionPath p = {});
 };
 
-/// One stroke of a top skin, as the low-to-high rule sees it: its mean height and the heights
-/// of its two ends (mm).
+/// One stroke of a top skin, as the low-to-high rule sees it: its mean height, the heights of
+/// its two ends, the box round its points and its bead's width (mm).
 struct StrokeHeights {
   double mean = 0, first = 0, last = 0;
+  ReachBox box;
 };
 
 /// The rule of DESIGN.md §3 for one run of top-skin strokes: they print by mean height, lowest
-/// first (stable), each from its low end. Output: the order (indices into `strokes`), and for
-/// each stroke whether it is to be printed backwards.
+/// first (stable), each from its low end, in groups of strokes that can touch (reach_groups.hpp),
+/// a group whole before the next (by their lowest strokes). Output: the order (indices into
+/// `strokes`), and for each stroke whether it is to be printed backwards.
 struct LowToHigh {
   std::vector<std::size_t> order;
   std::vector<char> reverse;
 };
-LowToHigh low_to_high(const std::vector<StrokeHeights>& strokes);
+LowToHigh low_to_high(const std::vector<StrokeHeights>& strokes, const Toolhead& head);
 
 /// Top skins on a slope, low to high (DESIGN.md §3: a line printed beside a higher line of
 /// the same layer drags the nozzle's flat through it). In each run of "Top solid infill" the

@@ -2,6 +2,7 @@
 // high, each from its low end.
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "program/layer_passes.hpp"
 
@@ -16,14 +17,26 @@ GcodeLine LayerWork::add(GcodeMove m, ExtrusionPath p) {
   return it;
 }
 
-LowToHigh low_to_high(const std::vector<StrokeHeights>& strokes) {
+LowToHigh low_to_high(const std::vector<StrokeHeights>& strokes, const Toolhead& head) {
   LowToHigh r;
-  r.order.resize(strokes.size());
-  r.reverse.resize(strokes.size());
-  for (std::size_t i = 0; i < strokes.size(); ++i)
+  const std::size_t n = strokes.size();
+  r.order.resize(n);
+  r.reverse.resize(n);
+  std::vector<ReachBox> boxes(n);
+  for (std::size_t i = 0; i < n; ++i) {
     r.order[i] = i, r.reverse[i] = strokes[i].first > strokes[i].last + 1e-9;
+    boxes[i] = strokes[i].box;
+  }
   std::stable_sort(r.order.begin(), r.order.end(),
                    [&](std::size_t a, std::size_t b) { return strokes[a].mean < strokes[b].mean; });
+  const std::vector<std::size_t> group = reach_groups(boxes, head);
+  std::vector<std::size_t> rank(n, n);  // each group's place: by its lowest stroke
+  std::size_t groups = 0;
+  for (std::size_t k : r.order)
+    if (rank[group[k]] == n) rank[group[k]] = groups++;
+  if (groups > 1)
+    std::stable_sort(r.order.begin(), r.order.end(),
+                     [&](std::size_t a, std::size_t b) { return rank[group[a]] < rank[group[b]]; });
   return r;
 }
 
@@ -127,8 +140,11 @@ void order_top_skins(LayerWork& w, const LayerPassParams& params) {
   auto heights = [&](const std::vector<int>& stroke) {
     StrokeHeights h;
     std::size_t n = 0;
-    for (int m : stroke)
-      for (const Vec3& v : w.mapped[static_cast<std::size_t>(m)].points) h.mean += v.z(), ++n;
+    for (int m : stroke) {
+      const ExtrusionPath& p = w.mapped[static_cast<std::size_t>(m)];
+      for (const Vec3& v : p.points) h.mean += v.z(), h.box.extend(v), ++n;
+      h.box.width = std::max(h.box.width, p.width);
+    }
     h.mean = n ? h.mean / static_cast<double>(n) : 0.0;
     h.first = w.mapped[static_cast<std::size_t>(stroke.front())].points.front().z();
     h.last = w.mapped[static_cast<std::size_t>(stroke.back())].points.back().z();
@@ -143,7 +159,7 @@ void order_top_skins(LayerWork& w, const LayerPassParams& params) {
     if (r.strokes.empty()) continue;
     std::vector<StrokeHeights> h;
     for (const auto& stroke : r.strokes) h.push_back(heights(stroke));
-    const LowToHigh order = low_to_high(h);
+    const LowToHigh order = low_to_high(h, params.head);
     std::vector<GcodeLine> out{seq[s]};
     out.insert(out.end(), r.head.begin(), r.head.end());
     Vec3 prev = w.moves[static_cast<std::size_t>(r.strokes[order.order[0]].front())].from;

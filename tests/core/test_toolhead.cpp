@@ -39,6 +39,21 @@ TEST(Toolhead, RoundHeadIsTheConeUnderACylinder) {
   EXPECT_NEAR(HeadClearance(t).allowance({2.4, 0}), 2.0 * std::tan(15 * M_PI / 180), 1e-12);
 }
 
+TEST(Toolhead, ReachUnderAHeightIsTheConesOrTheBlocks) {
+  Toolhead t;  // tip 0.4, cone 45°, block r 8 from 4 mm
+  EXPECT_NEAR(t.reach_under(0), 0.4, 1e-12);
+  EXPECT_NEAR(t.reach_under(1.5), 1.9, 1e-12);  // the cone's wall at 45°
+  EXPECT_NEAR(t.reach_under(4), 4.4, 1e-12);    // the block starts above 4 mm
+  EXPECT_DOUBLE_EQ(t.reach_under(4.01), 8.0);
+  EXPECT_DOUBLE_EQ(t.reach_under(100), t.reach());
+  Toolhead s;  // a duct 20 mm off the nozzle from 2 mm up, a block over it from 5 mm
+  s.shape = {{2, {{{18, -3}, {22, -3}, {22, 3}, {18, 3}}}},
+             {5, {{{-10, -10}, {10, -10}, {10, 10}, {-10, 10}}}}};
+  EXPECT_NEAR(s.reach_under(1), 1.4, 1e-12);                    // the cone alone
+  EXPECT_NEAR(s.reach_under(3), std::hypot(22.0, 3.0), 1e-12);  // and the duct
+  EXPECT_NEAR(s.reach_under(100), s.reach(), 1e-12);
+}
+
 TEST(Toolhead, ShapeSlicesCoverTheirPolygonsFromTheirHeightUp) {
   // A fan duct 2 mm up on the right, a probe 1 mm up at the back-left, the block at 3 mm.
   const Toolhead t = shaped({{3, {rect(-6, -6, 6, 6)}},
