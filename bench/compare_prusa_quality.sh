@@ -3,7 +3,8 @@
 # planar one, side by side, measured by `nonplanar check` on both G-code files.
 # Usage: bench/compare_prusa_quality.sh [MODEL...]
 # Default models: the end-to-end and coverage issues' analytic solids (written by build/bench/
-# make_test_solids), the shared curved models (wing, FoilCutter, sphere),
+# make_test_solids: among them #19's hollow shells, tall reliefs, a mouse's shell, a top over a
+# pocket, a top partly under another, a CAD block's fillets and a terrain tile), the shared curved models (wing, FoilCutter, sphere),
 # examples/wave_roof.stl and seven shared real parts (ankle base, car, airfoil, the Voron
 # ornament, the OpenSCAD heightmap, Benchy, the Slic3r spiky block; give the bunny by name: it
 # takes a minute). Same
@@ -22,7 +23,10 @@ if ((${#models[@]} == 0)); then
   models=("$tmp"/solids/saddle.stl "$tmp"/solids/sine_roof.stl "$tmp"/solids/domed_towers.stl
           "$tmp"/solids/dome_cut_by_box.stl "$tmp"/solids/rib.stl "$tmp"/solids/rib_beside_tower.stl
           "$tmp"/solids/hollow_roof_1.5mm.stl "$tmp"/solids/hollow_roof_0.8mm.stl
-          "$tmp"/solids/rib_and_domed_tower.stl
+          "$tmp"/solids/rib_and_domed_tower.stl "$tmp"/solids/two_reliefs.stl
+          "$tmp"/solids/mouse_shell.stl "$tmp"/solids/top_over_pocket.stl
+          "$tmp"/solids/tops_one_over_another.stl "$tmp"/solids/filleted_block.stl
+          "$tmp"/solids/terrain_tile.stl
           ../shared/models/np_curvislicer_wing.stl
           ../shared/models/np_curvislicer_FoilCutter.stl ../shared/models/np_prusa_sphere.stl
           examples/wave_roof.stl ../shared/models/np_curvislicer_anklebase_small.stl

@@ -8,8 +8,8 @@
 # Usage: bench/compare_prusa_slice.sh [RUNS=3] [MODEL...]
 # Default models: Benchy and the bunny, the shared curved models (wing, FoilCutter, sphere,
 # the CurviSlicer car and airfoil, the Voron ornament, the OpenSCAD heightmap),
-# examples/wave_roof.stl and three analytic solids written by build/bench/make_test_solids
-# (saddle, sine roof, dome cut by a box). Installs prusa-slicer through scripts/setup.sh if
+# examples/wave_roof.stl (a wave tile) and four solids written by build/bench/make_test_solids
+# (saddle, sine roof, dome cut by a box, a terrain tile). Installs prusa-slicer through scripts/setup.sh if
 # needed, and builds.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -26,7 +26,8 @@ if ((${#models[@]} == 0)); then
           "$s"/np_curvislicer_FoilCutter.stl "$s"/np_prusa_sphere.stl "$s"/np_curvislicer_car_med.stl
           "$s"/np_curvislicer_airfoil.stl "$s"/np_voron_sphere_ornament_shellA.stl
           "$s"/np_openscad_example010_heightmap.stl examples/wave_roof.stl
-          "$tmp"/solids/saddle.stl "$tmp"/solids/sine_roof.stl "$tmp"/solids/dome_cut_by_box.stl)
+          "$tmp"/solids/saddle.stl "$tmp"/solids/sine_roof.stl "$tmp"/solids/dome_cut_by_box.stl
+          "$tmp"/solids/terrain_tile.stl)
 fi
 
 # The same print both ways: 0.2 mm layers, 2 perimeters, 5 top / 4 bottom solid layers,

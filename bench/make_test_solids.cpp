@@ -27,7 +27,12 @@ int main(int argc, char** argv) {
       {"hollow_roof_1.5mm.stl", t::hollow_roof(1.5)},
       {"hollow_roof_0.8mm.stl", t::hollow_roof(0.8)},
       {"two_reliefs.stl", t::two_reliefs()},
-      {"rib_and_domed_tower.stl", t::rib_and_domed_tower()}};
+      {"rib_and_domed_tower.stl", t::rib_and_domed_tower()},
+      {"mouse_shell.stl", t::mouse_shell()},
+      {"top_over_pocket.stl", t::top_over_pocket()},
+      {"tops_one_over_another.stl", t::tops_one_over_another()},
+      {"filleted_block.stl", t::filleted_block()},
+      {"terrain_tile.stl", t::terrain_tile()}};
   for (const auto& [name, mesh] : solids) {
     auto w = nonplanar::write_stl(dir / name, mesh);
     if (!w) {

@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <utility>
@@ -205,6 +206,69 @@ TriangleMesh two_reliefs() {
     return 10 + 3 * std::cos(2 * M_PI * (x - 45) / 25) * std::cos(y / 8);
   };
   return height_field_solid(top, 0, 70, 0, 30, 280, 60);
+}
+
+namespace {
+
+// A closed void: the solid's faces turned inside out.
+TriangleMesh inside_out(TriangleMesh m) {
+  for (auto& f : m.faces) std::swap(f[1], f[2]);
+  return m;
+}
+
+}  // namespace
+
+TriangleMesh mouse_shell() {
+  const double wall = 1.2;
+  auto top = [](double x, double y) {
+    const double u = (x - 4) / 26, v = y / 18;
+    return 3 + 7 * (1 - u * u) * (1 - v * v);
+  };
+  TriangleMesh m = height_field_solid(top, -22, 22, -13, 13, 88, 52);
+  append(m, inside_out(height_field_solid([&](double x, double y) { return top(x, y) - wall; },
+                                          -22 + wall, 22 - wall, -13 + wall, 13 - wall, 84, 48,
+                                          wall)));
+  return m;
+}
+
+TriangleMesh top_over_pocket() {
+  TriangleMesh m = height_field_solid(
+      [](double x, double y) { return 8 + 1.5 * std::sin(x / 6) * std::cos(y / 8); }, 0, 40, 0, 30,
+      80, 60);
+  append(m, inside_out(box({10, 8, 1.5}, {30, 22, 5})));
+  return m;
+}
+
+TriangleMesh tops_one_over_another() {
+  TriangleMesh m =
+      height_field_solid([](double x, double y) { return 5 + std::cos(x / 7) * std::cos(y / 6); },
+                         0, 40, 0, 30, 80, 60);
+  append(m, box({40, 5, 0}, {50, 25, 11}));
+  append(m, height_field_solid(
+                [](double x, double y) {
+                  return 13 + std::cos((x - 40) / 6) * std::cos((y - 15) / 6);
+                },
+                30, 50, 5, 25, 40, 40, 10));
+  return m;
+}
+
+TriangleMesh filleted_block() {
+  const double r = 5, x1 = 40, y1 = 30, h = 12;
+  auto top = [&](double x, double y) {
+    const double a = std::max(0.0, r - std::min(x, x1 - x)),
+                 b = std::max(0.0, r - std::min(y, y1 - y));
+    return h - r + std::sqrt(std::max(0.0, r * r - a * a - b * b));
+  };
+  return height_field_solid(top, 0, x1, 0, y1, 160, 120);
+}
+
+TriangleMesh terrain_tile() {
+  auto top = [](double x, double y) {
+    return 6 + 1.8 * std::sin(x / 7 + 0.3) * std::cos(y / 9 + 1.1) +
+           0.8 * std::sin(x / 3.7 + 2) * std::sin(y / 4.3 + 0.5) +
+           0.3 * std::cos(x / 2.1 + 1) * std::sin(y / 1.9 + 2.2);
+  };
+  return height_field_solid(top, 0, 50, 0, 50, 100, 100);
 }
 
 TriangleMesh hollow_roof(double wall) {

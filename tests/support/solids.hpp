@@ -74,6 +74,28 @@ TriangleMesh rib_and_domed_tower();
 /// rib, so one slicer run cannot print it (another slicer prints the stack).
 TriangleMesh rib_and_small_domed_tower();
 
+/// The shapes #19 asks the quality figures for, beside the ones above (a hollow dome: the hollow
+/// roofs; a tall relief on a low base: the two reliefs):
+/// mouse shell: 44 × 26 mm, top 3 + 7 (1 − ((x − 4) / 26)²)(1 − (y / 18)²) about its centre
+/// (x −22–22, y −13–13; at most 29° steep), hollow: walls and floor 1.2 mm, its ceiling the top
+/// lowered by 1.2 mm, as a computer mouse's shell;
+TriangleMesh mouse_shell();
+/// top over a pocket: 40 × 30 mm, top 8 + 1.5 sin(x / 6) cos(y / 8) (at most 15° steep), over a
+/// closed 20 × 14 × 3.5 mm pocket (x 10–30, y 8–22, z 1.5–5) under part of it;
+TriangleMesh top_over_pocket();
+/// tops one over another: a 40 × 30 mm block, top 5 + cos(x / 7) cos(y / 6), and a 10 × 20 mm
+/// column beside it (x 40–50, y 5–25, 11 mm tall) under a shelf from z = 10, top
+/// 13 + cos((x − 40) / 6) cos((y − 15) / 6), reaching 10 mm out over the block (x 30–50);
+TriangleMesh tops_one_over_another();
+/// filleted block: a CAD block 40 × 30 × 12 mm whose top edges and corners are rounded with
+/// 5 mm fillets (a quarter circle from the walls' top at z = 7 to the flat top; a sphere at
+/// each corner): its curved top is the fillets' band from 2° to 30°, 2.3 mm wide;
+TriangleMesh filleted_block();
+/// terrain tile: 50 × 50 mm, top 6 + 1.8 sin(x / 7 + 0.3) cos(y / 9 + 1.1)
+/// + 0.8 sin(x / 3.7 + 2) sin(y / 4.3 + 0.5) + 0.3 cos(x / 2.1 + 1) sin(y / 1.9 + 2.2): hills
+/// and hollows, mostly under 30° steep.
+TriangleMesh terrain_tile();
+
 /// The shared test models folder (../shared/models beside the repo); empty if absent.
 std::filesystem::path shared_models();
 
