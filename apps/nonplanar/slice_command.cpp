@@ -248,6 +248,9 @@ void register_slice(CLI::App& app, std::function<int()>* run_fn) {
       {"perimeters", "Perimeter loops"},
       {"top_solid_layers", "Solid layers under top surfaces"},
       {"bottom_solid_layers", "Solid layers over bottom surfaces"},
+      {"shell_layers",
+       "Curved layers of a shell over a planar core (0 = automatic: 0.8 mm,\n"
+       "at least 3; fewer print faster, the core's solid layers under them)"},
       {"temperature", "Nozzle temperature (C)"},
       {"bed_temperature", "Bed temperature (C)"},
       {"nozzle_diameter", "Nozzle diameter (mm)"},

@@ -99,6 +99,9 @@ struct PrintConfig {
   /// h_min = min(0.1, layer_height),
   /// h_max = min(nozzle, max(1.5 layer_height, min(0.75 nozzle, 0.3))).
   double min_layer_height = 0, max_layer_height = 0;
+  /// Curved layers of a shell over a planar core (`shell_layers`, ours; 0 = automatic: 0.8 mm
+  /// of them, at least 3). The core prints its own top solid layers under the shell's lowest.
+  int shell_layers = 0;
   SliceParams slice;
   ToolpathParams paths;
   GcodeParams gcode;

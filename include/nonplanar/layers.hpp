@@ -38,6 +38,8 @@ struct LayerParams {
   /// The stack's top lies on the patch's facets (src/layers/faceted_top.hpp) rather than on
   /// the smooth fit through their vertices.
   bool faceted_top = true;
+  /// Curved layers of a shell over a planar core (0: automatic, 0.8 mm of them, at least 3).
+  int shell_layers = 0;
 };
 
 /// The curved layers of one patch.

@@ -261,7 +261,8 @@ ShellPlan plan_shell(const TriangleMesh& mesh, const Analysis& a, const std::vec
   s.reach = s.t - p.min_layer_height - kMargin;
   // A shell as thick as about four layers: solid under the top, and no deeper than needed
   // (features below it keep planar layers).
-  s.N = std::max(3, static_cast<int>(std::ceil(0.8 / s.t - 1e-9)));
+  s.N = p.shell_layers > 0 ? p.shell_layers
+                           : std::max(3, static_cast<int>(std::ceil(0.8 / s.t - 1e-9)));
   // H over the part's footprint (a pad as wide on every side as the patches' farthest side
   // needs); with a frame, over the patches' surroundings only (a further shell: the bunny's
   // tail took a raster twice the bunny's size, 0.5 s a plan).

@@ -39,6 +39,7 @@ SliceJob make_job(const PrintConfig& print, double max_angle_deg) {
     j.analysis.max_angle_deg = j.layers.max_angle_deg = cone;
   }
   j.layers.toolhead = print.toolhead;
+  j.layers.shell_layers = print.shell_layers;
   j.map_back.tip_radius = print.toolhead.tip_radius;
   j.map_back.passes.head = print.toolhead;
   j.map_back.min_layer_height = j.layers.min_layer_height;

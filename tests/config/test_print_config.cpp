@@ -112,6 +112,9 @@ TEST(Config, EverySettingHasARange) {
       {"first_layer_extrusion_width", "1000%"},
       {"first_layer_height", "0.3%"},  // fuzz_settings: 0.6 µm layers ordered for minutes
       {"layer_height", "0.005"},
+      {"shell_layers", "21"},
+      {"shell_layers", "-1"},
+      {"shell_layers", "2.5"},
   };
   for (const auto& [key, value] : cases) {
     PrintConfig c;
