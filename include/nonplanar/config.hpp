@@ -102,6 +102,10 @@ struct PrintConfig {
   /// Curved layers of a shell over a planar core (`shell_layers`, ours; 0 = automatic: 0.8 mm
   /// of them, at least 3). The core prints its own top solid layers under the shell's lowest.
   int shell_layers = 0;
+  /// The largest share of a shell's curved top it may print in bands beside what stands above
+  /// it (`shell_max_banded`, ours, 0 to 1): past it the shell is refused, as its bands cost
+  /// print time.
+  double shell_max_banded = 0.5;
   SliceParams slice;
   ToolpathParams paths;
   GcodeParams gcode;

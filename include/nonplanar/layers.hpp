@@ -40,6 +40,8 @@ struct LayerParams {
   bool faceted_top = true;
   /// Curved layers of a shell over a planar core (0: automatic, 0.8 mm of them, at least 3).
   int shell_layers = 0;
+  /// The largest share of a shell's patches it may print in bands (shell_region.hpp).
+  double shell_max_banded = 0.5;
 };
 
 /// The curved layers of one patch.

@@ -226,6 +226,7 @@ Expected<bool> set_value(PrintConfig& c, const std::string& key, const std::stri
   if (key == "start_filament_gcode") return g.start_filament_gcode = first_string(value), true;
   if (key == "end_filament_gcode") return g.end_filament_gcode = first_string(value), true;
   if (key == "shell_layers") return integer(c.shell_layers);
+  if (key == "shell_max_banded") return num(c.shell_max_banded);
   Toolhead& head = c.toolhead;
   if (key == "nozzle_tip_radius") return num(head.tip_radius);
   if (key == "nozzle_cone_angle") return num(head.cone_angle_deg);
@@ -298,7 +299,8 @@ std::string default_start_gcode(const Vec2& bed_min, const Vec2& bed_max) {
 
 bool is_nonplanar_key(const std::string& key) {
   return key == "nozzle_tip_radius" || key == "nozzle_cone_angle" || key == "heater_block_radius" ||
-         key == "heater_block_clearance" || key == "toolhead_shape" || key == "shell_layers";
+         key == "heater_block_clearance" || key == "toolhead_shape" || key == "shell_layers" ||
+         key == "shell_max_banded";
 }
 
 // Ranges: wide enough for any real printer, narrow enough that every value formats into a
@@ -338,6 +340,7 @@ Expected<void> validate_config(const PrintConfig& c) {
   if (t.perimeters < 0 || t.perimeters > 100) return bad("perimeters", "must be 0 to 100");
   if (c.shell_layers < 0 || c.shell_layers > 20)
     return bad("shell_layers", "must be 0 (automatic) to 20");
+  if (!in(c.shell_max_banded, 0, 1)) return bad("shell_max_banded", "must be 0 to 1");
   if (t.top_solid_layers < 0 || t.top_solid_layers > 1000 || t.bottom_solid_layers < 0 ||
       t.bottom_solid_layers > 1000)
     return bad("top_solid_layers/bottom_solid_layers", "must be 0 to 1000");

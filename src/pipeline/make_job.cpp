@@ -40,6 +40,7 @@ SliceJob make_job(const PrintConfig& print, double max_angle_deg) {
   }
   j.layers.toolhead = print.toolhead;
   j.layers.shell_layers = print.shell_layers;
+  j.layers.shell_max_banded = print.shell_max_banded;
   j.map_back.tip_radius = print.toolhead.tip_radius;
   j.map_back.passes.head = print.toolhead;
   j.map_back.min_layer_height = j.layers.min_layer_height;

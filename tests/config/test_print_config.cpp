@@ -115,6 +115,8 @@ TEST(Config, EverySettingHasARange) {
       {"shell_layers", "21"},
       {"shell_layers", "-1"},
       {"shell_layers", "2.5"},
+      {"shell_max_banded", "1.5"},
+      {"shell_max_banded", "-0.1"},
   };
   for (const auto& [key, value] : cases) {
     PrintConfig c;

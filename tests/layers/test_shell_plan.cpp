@@ -210,6 +210,13 @@ TEST(ShellPlan, RefusesAShellMostlyPrintedInBands) {
   // It says why it is not the wider one (slice's notice and `layers` print it).
   EXPECT_EQ(rim.narrowed, "a shell over patches 0, 1: " + why);
   EXPECT_TRUE(layers::plan_shell(m->mesh, a, {0}, LayerParams{}).narrowed.empty());
+  // The limit is a setting (shell_max_banded): at 1 the shell over both is planned, banded
+  // over 69 % of them.
+  LayerParams any;
+  any.shell_max_banded = 1;
+  const layers::ShellPlan both = layers::plan_shell(m->mesh, a, {0, 1}, any);
+  EXPECT_TRUE(both.refused.empty()) << both.refused;
+  EXPECT_EQ(layers::choose_shell(m->mesh, a, any).patches, (std::vector<int>{0, 1}));
 }
 
 }  // namespace
