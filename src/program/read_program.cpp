@@ -14,6 +14,9 @@
 #include "nonplanar/program.hpp"
 
 namespace nonplanar {
+
+// A file's moves and lines are held whole (program.hpp): no padding back in between members.
+static_assert(sizeof(void*) != 8 || (sizeof(GcodeMove) == 120 && sizeof(GcodeLine) == 40));
 namespace {
 
 // A bridge's or an overhang's ;HEIGHT: is its round bead's (the nozzle's diameter), not the
