@@ -111,7 +111,7 @@ HeadClearance::HeadClearance(const Toolhead& head, double tallest)
   if (!shaped_) return;
   // A slice at or above `tallest` never holds a(d) below what material can reach.
   std::erase_if(head_.shape, [&](const ToolheadSlice& s) { return s.height >= tallest; });
-  reach_ = shape_reach(head_, std::min(cone_top_, std::max(0.0, tallest)));
+  reach_ = head.reach_under(tallest);
 }
 
 // `nearest`: the offset nearest the axis (of the box, or d itself); with in_box, slices count

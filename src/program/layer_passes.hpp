@@ -7,7 +7,6 @@
 #include <vector>
 
 #include "nonplanar/program.hpp"
-#include "nonplanar/toolhead.hpp"
 #include "nonplanar/toolpaths.hpp"
 #include "program/reach_groups.hpp"
 

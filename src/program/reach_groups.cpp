@@ -2,6 +2,7 @@
 #include "program/reach_groups.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 
 namespace nonplanar::program {

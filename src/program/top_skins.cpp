@@ -2,7 +2,6 @@
 // high, each from its low end.
 #include <algorithm>
 #include <cmath>
-#include <limits>
 
 #include "program/layer_passes.hpp"
 
