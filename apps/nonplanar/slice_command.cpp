@@ -249,11 +249,11 @@ void register_slice(CLI::App& app, std::function<int()>* run_fn) {
       {"top_solid_layers", "Solid layers under top surfaces"},
       {"bottom_solid_layers", "Solid layers over bottom surfaces"},
       {"shell_layers",
-       "Curved layers of a shell over a planar core (0 = automatic: 0.8 mm,\n"
-       "at least 3; fewer print faster, the core's solid layers under them)"},
+       "Curved layers of a shell over a planar core (0 = automatic: 0.4 mm,\n"
+       "at least 2; more print slower, the core's solid layers under them)"},
       {"shell_max_banded",
        "Largest share of a shell printed in bands beside taller parts\n"
-       "(0 to 1, default 0.5; bands cost print time)"},
+       "(0 to 1, default 1; bands cost print time, past it planar)"},
       {"temperature", "Nozzle temperature (C)"},
       {"bed_temperature", "Bed temperature (C)"},
       {"nozzle_diameter", "Nozzle diameter (mm)"},

@@ -99,13 +99,13 @@ struct PrintConfig {
   /// h_min = min(0.1, layer_height),
   /// h_max = min(nozzle, max(1.5 layer_height, min(0.75 nozzle, 0.3))).
   double min_layer_height = 0, max_layer_height = 0;
-  /// Curved layers of a shell over a planar core (`shell_layers`, ours; 0 = automatic: 0.8 mm
-  /// of them, at least 3). The core prints its own top solid layers under the shell's lowest.
+  /// Curved layers of a shell over a planar core (`shell_layers`, ours; 0 = automatic: 0.4 mm
+  /// of them, at least 2). The core prints its own top solid layers under the shell's lowest.
   int shell_layers = 0;
   /// The largest share of a shell's curved top it may print in bands beside what stands above
   /// it (`shell_max_banded`, ours, 0 to 1): past it the shell is refused, as its bands cost
-  /// print time.
-  double shell_max_banded = 0.5;
+  /// print time (1: never refused for that).
+  double shell_max_banded = 1.0;
   SliceParams slice;
   ToolpathParams paths;
   GcodeParams gcode;

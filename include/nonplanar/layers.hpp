@@ -38,10 +38,10 @@ struct LayerParams {
   /// The stack's top lies on the patch's facets (src/layers/faceted_top.hpp) rather than on
   /// the smooth fit through their vertices.
   bool faceted_top = true;
-  /// Curved layers of a shell over a planar core (0: automatic, 0.8 mm of them, at least 3).
+  /// Curved layers of a shell over a planar core (0: automatic, 0.4 mm of them, at least 2).
   int shell_layers = 0;
   /// The largest share of a shell's patches it may print in bands (shell_region.hpp).
-  double shell_max_banded = 0.5;
+  double shell_max_banded = 1.0;
 };
 
 /// The curved layers of one patch.

@@ -8,6 +8,7 @@
 
 #include "core/parallel.hpp"
 #include "core/polygon_ops.hpp"
+#include "engine/top_direction.hpp"
 #include "layers/height_contour.hpp"
 #include "nonplanar/deform.hpp"
 #include "program/reach_groups.hpp"
@@ -245,6 +246,10 @@ Expected<std::vector<LayerToolpaths>> shell_layers(const TriangleMesh& mesh,
     for (SlicedLayer& l : *cut) l.islands = clip::intersection_ex(l.islands, R);
   ToolpathParams tp = print.paths;
   tp.skirts = 0;
+  // The top's lines up and down its slopes (top_direction.hpp). Layer i of the cut has its
+  // lines at fill_angle + 90°·(i mod 2); the top is i = N.
+  if (const auto dir = top_slope_direction(mesh, plan, 2.0, 45.0))
+    tp.fill_angle = *dir - 90.0 * (plan.N % 2);
   auto planar = make_toolpaths(*cut, tp, ctx);
   if (!planar) return planar.error();
   planar->erase(planar->begin());

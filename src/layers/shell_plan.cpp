@@ -259,10 +259,12 @@ ShellPlan plan_shell(const TriangleMesh& mesh, const Analysis& a, const std::vec
     return s;
   }
   s.reach = s.t - p.min_layer_height - kMargin;
-  // A shell as thick as about four layers: solid under the top, and no deeper than needed
-  // (features below it keep planar layers).
+  // A shell of about two layers: the core prints its own top solid layers under it, so the
+  // shell only has to fill the stairs and lay the top; each layer more costs print time and
+  // gains nothing measurable (four against two on ten real parts: the share within 0.03 mm
+  // moved by at most 0.009, the prints took 2-22 % longer). Features below keep planar layers.
   s.N = p.shell_layers > 0 ? p.shell_layers
-                           : std::max(3, static_cast<int>(std::ceil(0.8 / s.t - 1e-9)));
+                           : std::max(2, static_cast<int>(std::ceil(0.4 / s.t - 1e-9)));
   // H over the part's footprint (a pad as wide on every side as the patches' farthest side
   // needs); with a frame, over the patches' surroundings only (a further shell: the bunny's
   // tail took a raster twice the bunny's size, 0.5 s a plan).

@@ -129,13 +129,13 @@ TEST(Cli, LayersAndSliceReportTheShell) {
   const CliResult r = run("layers -q " + (dir / "rib.stl").string());
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find("0 curved stacks"), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("shell: patch 0 as 4 curved layers of 0.20 mm over"), std::string::npos)
+  EXPECT_NE(r.out.find("shell: patch 0 as 2 curved layers of 0.20 mm over"), std::string::npos)
       << r.out;
   const CliResult s =
       run("slice " + (dir / "rib.stl").string() + " -o " + (dir / "r.gcode").string());
   ASSERT_EQ(s.code, 0) << s.err;
-  EXPECT_NE(s.err.find("a curved shell of 4 layers"), std::string::npos) << s.err;
-  EXPECT_NE(test::read_bytes(dir / "r.gcode").find("; patch 0: a shell of 4 curved layers"),
+  EXPECT_NE(s.err.find("a curved shell of 2 layers"), std::string::npos) << s.err;
+  EXPECT_NE(test::read_bytes(dir / "r.gcode").find("; patch 0: a shell of 2 curved layers"),
             std::string::npos);
 }
 
@@ -146,7 +146,7 @@ TEST(Cli, LayersAndSliceReportAShellBesideAStack) {
   const CliResult r = run("layers -q " + (dir / "p.stl").string());
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find("1 curved stack,"), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("shell beside the stacks: patch 1 as 4 curved layers"), std::string::npos)
+  EXPECT_NE(r.out.find("shell beside the stacks: patch 1 as 2 curved layers"), std::string::npos)
       << r.out;
   const CliResult s =
       run("slice " + (dir / "p.stl").string() + " -o " + (dir / "p.gcode").string());
@@ -155,7 +155,7 @@ TEST(Cli, LayersAndSliceReportAShellBesideAStack) {
             std::string::npos)
       << s.err;
   const std::string g = test::read_bytes(dir / "p.gcode");
-  EXPECT_NE(g.find("; patch 1: a shell of 4 curved layers"), std::string::npos);
+  EXPECT_NE(g.find("; patch 1: a shell of 2 curved layers"), std::string::npos);
   EXPECT_NE(g.find("; patch 0: "), std::string::npos);
 }
 

@@ -105,7 +105,7 @@ TEST(EnginePrusaSlicer, WingPrintsAsAShellOverItsCore) {
       {"fill_density", "100%"}, {"fill_pattern", "rectilinear"}, {"use_relative_e_distances", "1"}};
   auto r = slice_model(m->mesh, job, {});
   ASSERT_TRUE(r) << r.error().message;
-  EXPECT_EQ(r->shell_layers, 4);
+  EXPECT_EQ(r->shell_layers, 2);
   auto moves = read_gcode_moves(r->gcode);
   ASSERT_TRUE(moves) << moves.error().message;
   auto f = check_print(*moves, &m->mesh, {}, {});
@@ -146,7 +146,7 @@ TEST(EnginePrusaSlicer, AShellPrintsWithSupportsOn) {
   job.engine.overrides = {{"support_material", "1"}};
   auto r = slice_model(mesh, job, {});
   ASSERT_TRUE(r) << r.error().message;
-  EXPECT_EQ(r->shell_layers, 4);
+  EXPECT_EQ(r->shell_layers, 2);
   EXPECT_EQ(r->collisions, 0u);
   EXPECT_NE(r->gcode.find(";TYPE:Support material"), std::string::npos);
   // One run, supports kept off the slab by a blocker (SupportBlockerKeepsSupportsOff).

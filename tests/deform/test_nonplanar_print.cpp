@@ -208,7 +208,7 @@ TEST(NonplanarPrint, RibTopFromNearTheBedPrintsAsAShell) {
   c.paths.fill_density = 1.0;
   const Outcome o = run(test::rib(), c);
   expect_good(o, 0);
-  EXPECT_EQ(o.result.shell_layers, 4);
+  EXPECT_EQ(o.result.shell_layers, 2);
   EXPECT_LE(o.figures.deviation_p95, 0.005);
   EXPECT_NEAR(o.figures.volume_ratio, 1.0, 0.03);
   ASSERT_FALSE(o.result.notices.empty());
@@ -225,7 +225,7 @@ TEST(NonplanarPrint, RibBesideATallerTowerPrintsAsAShellBetweenTheTowersLayers) 
   for (const TriangleMesh& m : {test::rib_beside_tower(), test::rib_against_tower()}) {
     const Outcome o = run(m, c);
     expect_good(o, 0);
-    EXPECT_EQ(o.result.shell_layers, 4);
+    EXPECT_EQ(o.result.shell_layers, 2);
     EXPECT_LE(o.figures.deviation_p95, 0.005);
     EXPECT_GT(o.figures.within_share, 0.93);
     EXPECT_NEAR(o.figures.volume_ratio, 1.0, 0.03);
@@ -253,7 +253,7 @@ TEST(NonplanarPrint, RibOverAVoidLeavesItsFootprintPlanar) {
   const Outcome o = run(m);
   const LayerParams lp = make_job(PrintConfig{}).layers;
   EXPECT_TRUE(o.result.nonplanar);
-  EXPECT_EQ(o.result.shell_layers, 4);
+  EXPECT_EQ(o.result.shell_layers, 2);
   EXPECT_EQ(o.figures.collisions, 0u);
   EXPECT_GE(o.figures.thickness_min, lp.min_layer_height - 1e-3);
   EXPECT_LE(o.figures.thickness_max, lp.max_layer_height + 1e-3);
@@ -268,10 +268,11 @@ TEST(NonplanarPrint, RibOverAVoidLeavesItsFootprintPlanar) {
 // stack fits, and a shell rests on the wall under the top. With 1.5 mm walls the usual four
 // layers fit over it; with 0.8 mm walls the ceiling lay within 0.5 mm under their bottom and
 // the shell was refused (planar: within 0.03 mm on 27 % of the top). Now it takes two layers,
-// the core's stairs standing on the ceiling beneath them.
+// the core's stairs standing on the ceiling beneath them. (Four asked for: the default is two.)
 TEST(NonplanarPrint, HollowRoofPrintsAShellAsDeepAsItsWallAllows) {
   PrintConfig c;
   c.paths.fill_density = 1.0;
+  c.shell_layers = 4;
   for (const auto& [wall, layers] : {std::pair{1.5, 4}, std::pair{0.8, 2}}) {
     SCOPED_TRACE(wall);
     const Outcome o = run(test::hollow_roof(wall), c);
@@ -292,7 +293,7 @@ TEST(NonplanarPrint, SharedWingPrintsAsAShell) {
   ASSERT_TRUE(m);
   const Outcome o = run(m->mesh);
   expect_good(o, 0);
-  EXPECT_EQ(o.result.shell_layers, 4);
+  EXPECT_EQ(o.result.shell_layers, 2);
 }
 
 // The CurviSlicer airfoil rib: a 2.5-3.6 mm upper skin over truss holes, its trailing edge
@@ -308,7 +309,7 @@ TEST(NonplanarPrint, SharedAirfoilRibPrintsAShellOverItsTrussHoles) {
   CheckParams cp;
   cp.min_angle_deg = 2;
   const Outcome o = run(m->mesh, {}, cp);
-  EXPECT_EQ(o.result.shell_layers, 4);
+  EXPECT_EQ(o.result.shell_layers, 2);
   EXPECT_EQ(o.figures.collisions, 0u);
   EXPECT_EQ(o.result.collisions, 0u);
   EXPECT_GT(o.figures.within_share, 0.8);
@@ -329,7 +330,7 @@ TEST(NonplanarPrint, SharedCarPrintsAShellWhereItsStacksCoverLittle) {
   CheckParams cp;
   cp.min_angle_deg = 2;
   const Outcome o = run(m->mesh, {}, cp);
-  EXPECT_EQ(o.result.shell_layers, 4);
+  EXPECT_EQ(o.result.shell_layers, 2);
   EXPECT_TRUE(o.result.plan.stacks.empty());
   EXPECT_EQ(o.figures.collisions, 0u);
   EXPECT_EQ(o.result.collisions, 0u);
@@ -356,7 +357,7 @@ TEST(NonplanarPrint, SharedSpikyBlockPrintsAShellOverAllItsFacets) {
   CheckParams cp;
   cp.min_angle_deg = 2;
   const Outcome o = run(m->mesh, {}, cp);
-  EXPECT_EQ(o.result.shell_layers, 4);
+  EXPECT_EQ(o.result.shell_layers, 2);
   EXPECT_EQ(o.figures.collisions, 0u);
   EXPECT_GT(o.figures.within_share, 0.8);
   const LayerParams lp = make_job(PrintConfig{}).layers;
@@ -425,13 +426,15 @@ void expect_shells_printed(const Outcome& o, std::size_t n, double share) {
 // The bunny's curved top lies at many heights: its back (112–129 mm), head (151–167 mm),
 // tail and a cheek. One shell over the back alone followed 54 % of it within 0.03 mm; the part
 // stands above that shell (the head), so each further group of patches gets its own shell,
-// planned over its surroundings only. 82 % within 0.03 mm, 0 collisions.
+// planned over its surroundings only. 82 % within 0.03 mm, 0 collisions. (By default one
+// shell follows it all, in bands beside the head, 52 % of it: 82.9 % within 0.03 mm.)
 TEST(NonplanarPrint, SharedBunnyPrintsAShellPerCurvedRegion) {
   const auto dir = test::shared_models();
   if (dir.empty()) GTEST_SKIP() << "../shared/models not present";
   auto m = load_mesh(dir / "np_stanford_bunny_closed_compas.stl", {}, {});
   ASSERT_TRUE(m);
-  const PrintConfig c;
+  PrintConfig c;
+  c.shell_max_banded = 0.5;
   const TriangleMesh mesh = test::placed(m->mesh, c);
   const Analysis a = *analyze(mesh, {}, {});
   const std::vector<layers::ShellPlan> shells = layers::choose_shells(mesh, a, make_job(c).layers);
@@ -456,7 +459,8 @@ double travel_length(const std::string& gcode) {
 // reliefs too tall for stacks, apart, each under its own shell on one core. 90.6 % of the
 // curved top within 0.03 mm, 0 collisions.
 TEST(NonplanarPrint, TwoReliefsApartGetAShellEach) {
-  const PrintConfig c;
+  PrintConfig c;
+  c.shell_max_banded = 0.5;  // one shell over both is banded over 57 % of it
   const TriangleMesh mesh = test::placed(test::two_reliefs(), c);
   const Analysis a = *analyze(mesh, {}, {});
   const std::vector<layers::ShellPlan> shells = layers::choose_shells(mesh, a, make_job(c).layers);
@@ -546,9 +550,9 @@ TEST(NonplanarPrint, ShellLayersIsASetting) {
 }
 
 // The CurviSlicer ankle base's outer ring lies under its inner ring's rim all round: a shell
-// over both is banded over 69 % of them, refused at the default shell_max_banded (0.5; the
-// inner ring alone gets a shell, 71.7 % of the curved top within 0.03 mm). Allowed, with 2
-// curved layers: 78.0 % within, 0 collisions, 50m27s against 47m25s.
+// over both is banded over 69 % of them. At shell_max_banded 0.5 it is refused (the inner ring
+// alone gets a shell: 72 % of the curved top within 0.03 mm); by default (1) it prints, its top
+// lines up and down the slope: 80.7 % within, 0 collisions, 50m25s against 47m10s.
 TEST(NonplanarPrint, BandedShellIsASetting) {
   const auto dir = test::shared_models();
   if (dir.empty()) GTEST_SKIP() << "../shared/models not present";
@@ -557,14 +561,13 @@ TEST(NonplanarPrint, BandedShellIsASetting) {
   CheckParams cp;
   cp.min_angle_deg = 2;
   PrintConfig c;
-  const Outcome held = run(m->mesh, c, cp);
-  ASSERT_TRUE(set_config_value(c, "shell_max_banded", "1"));
-  ASSERT_TRUE(set_config_value(c, "shell_layers", "2"));
   const Outcome banded = run(m->mesh, c, cp);
+  ASSERT_TRUE(set_config_value(c, "shell_max_banded", "0.5"));
+  const Outcome held = run(m->mesh, c, cp);
   EXPECT_EQ(banded.result.shell_layers, 2);
   EXPECT_EQ(banded.figures.collisions, 0u);
   EXPECT_GT(banded.figures.within_share, held.figures.within_share + 0.05);
-  EXPECT_GT(banded.figures.within_share, 0.77);
+  EXPECT_GE(banded.figures.within_share, 0.80);
 }
 
 // Stacks and a shell in one part (#19): the domed tower gets a stack, the rib beside it (no
@@ -578,7 +581,7 @@ TEST(NonplanarPrint, StackAndShellInOnePart) {
   cp.min_angle_deg = 2;
   const Outcome o = run(test::rib_and_domed_tower(), c, cp);
   ASSERT_EQ(o.result.plan.stacks.size(), 1u);
-  EXPECT_EQ(o.result.shell_layers, 4);
+  EXPECT_EQ(o.result.shell_layers, 2);
   EXPECT_EQ(o.result.printed_curved, 2);
   EXPECT_EQ(o.figures.collisions, 0u);
   EXPECT_EQ(o.result.collisions, 0u);
@@ -593,7 +596,7 @@ TEST(NonplanarPrint, StackAndShellInOnePart) {
   EXPECT_NEAR(steps, std::round(steps), 1e-6) << st.c;
   EXPECT_NE(o.gcode.find("; patch 0: " + std::to_string(st.layers) + " curved layers"),
             std::string::npos);
-  EXPECT_NE(o.gcode.find("a shell of 4 curved layers"), std::string::npos);
+  EXPECT_NE(o.gcode.find("a shell of 2 curved layers"), std::string::npos);
   // Without shells the rib prints planar.
   const TriangleMesh mesh = test::placed(test::rib_and_domed_tower(), c);
   SliceJob job = make_job(c);
@@ -694,7 +697,7 @@ TEST(NonplanarPrint, SharedHeightmapSaysItsStackBrokeALimitWhenAShellPrints) {
   auto m = load_mesh(dir / "np_openscad_example010_heightmap.stl", {}, {});
   ASSERT_TRUE(m);
   const Outcome o = run(m->mesh);
-  EXPECT_EQ(o.result.shell_layers, 4);
+  EXPECT_EQ(o.result.shell_layers, 2);
   EXPECT_EQ(o.figures.collisions, 0u);
   bool said = false;
   for (const Notice& n : o.result.notices)

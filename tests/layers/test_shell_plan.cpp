@@ -26,9 +26,13 @@ std::vector<int> curved(const Analysis& a) {
   return ids;
 }
 
-layers::ShellPlan plan(const TriangleMesh& m) {
+// The plan at the default settings but four curved layers (two by default), as these tests'
+// heights were worked out for.
+layers::ShellPlan plan(const TriangleMesh& m, int layers = 4) {
   const Analysis a = *analyze(m, {}, {});
-  return layers::plan_shell(m, a, curved(a), LayerParams{});
+  LayerParams lp;
+  lp.shell_layers = layers;
+  return layers::plan_shell(m, a, curved(a), lp);
 }
 
 // A closed box turned inside out: a void inside a solid (its floor faces up, its ceiling down).
@@ -165,6 +169,7 @@ TEST(ShellPlan, TakesFewerLayersOverAThinWall) {
   ASSERT_TRUE(s.refused.empty()) << s.refused;
   EXPECT_EQ(s.N, 3);
   EXPECT_EQ(plan(test::rib()).N, 4);
+  EXPECT_EQ(plan(test::rib(), 0).N, 2);  // automatic: 0.4 mm of layers
   EXPECT_GE(s.bottom(20, 6) - 6.25, 0.23 - 1e-6);
 }
 
@@ -202,18 +207,19 @@ TEST(ShellPlan, RefusesAShellMostlyPrintedInBands) {
   const Analysis a = *analyze(m->mesh, {}, {});
   ASSERT_EQ(a.patches.size(), 4u);
   ASSERT_TRUE(a.patches[0].needs_nonplanar() && a.patches[1].needs_nonplanar());
-  const std::string why = layers::plan_shell(m->mesh, a, {0, 1}, LayerParams{}).refused;
+  LayerParams half;  // the default allows any share in bands
+  half.shell_max_banded = 0.5;
+  const std::string why = layers::plan_shell(m->mesh, a, {0, 1}, half).refused;
   EXPECT_NE(why.find("in bands"), std::string::npos) << why;
-  const layers::ShellPlan rim = layers::choose_shell(m->mesh, a, LayerParams{});
+  const layers::ShellPlan rim = layers::choose_shell(m->mesh, a, half);
   EXPECT_TRUE(rim.refused.empty()) << rim.refused;
   EXPECT_EQ(rim.patches, std::vector<int>{0});
   // It says why it is not the wider one (slice's notice and `layers` print it).
   EXPECT_EQ(rim.narrowed, "a shell over patches 0, 1: " + why);
-  EXPECT_TRUE(layers::plan_shell(m->mesh, a, {0}, LayerParams{}).narrowed.empty());
-  // The limit is a setting (shell_max_banded): at 1 the shell over both is planned, banded
-  // over 69 % of them.
-  LayerParams any;
-  any.shell_max_banded = 1;
+  EXPECT_TRUE(layers::plan_shell(m->mesh, a, {0}, half).narrowed.empty());
+  // The limit is a setting (shell_max_banded): at 1, the default, the shell over both is
+  // planned, banded over 69 % of them.
+  const LayerParams any;
   const layers::ShellPlan both = layers::plan_shell(m->mesh, a, {0, 1}, any);
   EXPECT_TRUE(both.refused.empty()) << both.refused;
   EXPECT_EQ(layers::choose_shell(m->mesh, a, any).patches, (std::vector<int>{0, 1}));
