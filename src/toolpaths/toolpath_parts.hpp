@@ -23,9 +23,17 @@ std::vector<std::vector<Polygon>> perimeter_loops(const ExPolygons& island, int 
                                                   double s, ExPolygons* inner);
 
 /// Parallel lines at `angle_deg` spaced `spacing` (aligned to a global grid so layers match),
-/// clipped to `region` shrunk by s / 2 so the beads stay inside it.
-std::vector<Polyline> infill_lines(const ExPolygons& region, double angle_deg, double spacing,
-                                   double s);
+/// clipped to `region` shrunk by s / 2 so the beads stay inside it. With `fit` (solid fill),
+/// each island's lines instead run evenly from its one extreme across the lines to the other,
+/// the first and last s / 2 inside them, at the spacing nearest `spacing` within ±20 %: a
+/// side along the lines gets a line beside it, not a gap of up to a spacing (PrusaSlicer's
+/// full infill adjusts its spacing the same way). Each line comes with its spacing, mm.
+struct InfillLine {
+  Polyline line;
+  double spacing = 0;
+};
+std::vector<InfillLine> infill_lines(const ExPolygons& region, double angle_deg, double spacing,
+                                     double s, bool fit = false);
 
 /// The nearest-neighbour order of paths from `from`, reversing open paths and rotating
 /// closed loops (front == back) so each starts nearest to the nozzle.
