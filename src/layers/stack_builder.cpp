@@ -7,10 +7,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <functional>
 #include <optional>
 #include <utility>
-#include <vector>
 
 #include "layers/printability_cost.hpp"
 #include "nurbs/solver_callbacks.hpp"
@@ -56,60 +54,6 @@ class StackObjective final : public ceres::FirstOrderFunction {
   std::optional<double>* first_;
 };
 
-// An iteration callback that keeps in *kept the solver's last state `within` accepts, and stops
-// the solver at the first it does not after one it did (the state is read from x:
-// update_state_every_iteration). From a start beyond the limits (kept_within false) the solver
-// goes on until a state is within them; if none is, *kept is its last state, as without this.
-// A check costs a fine-grid measure (about as much as a step on the filleted block), so states
-// are checked at steps 1, 2, 4, 8, 16 and every 16th after; when one fails, a binary search
-// over the states since the last that passed finds one that passes and whose next does not.
-// finish() checks the solver's last state the same way.
-class WithinLimits final : public ceres::IterationCallback {
- public:
-  WithinLimits(std::function<bool(const std::vector<double>&)> within, const std::vector<double>& x,
-               std::vector<double>& kept, bool kept_within)
-      : within_(std::move(within)), x_(x), kept_(kept), seen_(kept_within) {}
-  ceres::CallbackReturnType operator()(const ceres::IterationSummary& s) override {
-    if (s.iteration == 0 || !s.step_is_successful) return ceres::SOLVER_CONTINUE;
-    since_.push_back(x_);
-    const int i = s.iteration;
-    if ((i & (i - 1)) != 0 && i % 16 != 0) return ceres::SOLVER_CONTINUE;
-    return settle() ? ceres::SOLVER_CONTINUE
-                    : (stopped_ = true, ceres::SOLVER_TERMINATE_SUCCESSFULLY);
-  }
-  /// After the solver: the states not checked yet.
-  void finish() {
-    if (!stopped_ && !since_.empty()) stopped_ = !settle();
-    if (!seen_) kept_ = x_;
-  }
-  bool stopped() const { return stopped_; }
-
- private:
-  // Whether to go on: the latest state passes (then it is kept), or none has yet.
-  bool settle() {
-    if (within_(since_.back())) {
-      kept_ = since_.back(), seen_ = true;
-      since_.clear();
-      return true;
-    }
-    if (!seen_) return since_.clear(), true;
-    std::ptrdiff_t lo = -1, hi = static_cast<std::ptrdiff_t>(since_.size()) - 1;
-    while (hi - lo > 1) {
-      const std::ptrdiff_t mid = (lo + hi) / 2;
-      (within_(since_[static_cast<std::size_t>(mid)]) ? lo : hi) = mid;
-    }
-    if (lo >= 0) kept_ = since_[static_cast<std::size_t>(lo)];
-    since_.clear();
-    return false;
-  }
-  std::function<bool(const std::vector<double>&)> within_;
-  const std::vector<double>& x_;
-  std::vector<double>& kept_;
-  std::vector<std::vector<double>> since_;  ///< states since the last that passed
-  bool seen_;                               ///< a state passed (or the start did)
-  bool stopped_ = false;
-};
-
 constexpr double kNoLimit = 1e300;
 
 struct Figures {
@@ -122,10 +66,9 @@ struct Figures {
 // Thickness and slope over the patch's samples; rise of each layer within the block radius
 // on a grid of about 1 mm. H, dH: the faceted top and its gradient at the samples (empty:
 // the top is the fit), with the layers between it and the plane c in the control heights'
-// proportions, as Band::surface places them. Without `with_rise`, thickness and slope only.
+// proportions, as Band::surface places them.
 Figures measure(const StackGrid& g, const Eigen::MatrixXd& Z, const LayerParams& p,
-                const std::vector<double>& H, const std::vector<Vec2>& dH, double c,
-                bool with_rise = true) {
+                const std::vector<double>& H, const std::vector<Vec2>& dH, double c) {
   Figures f;
   const int L = static_cast<int>(Z.rows());
   const int n = static_cast<int>(g.xy.size());
@@ -160,7 +103,6 @@ Figures measure(const StackGrid& g, const Eigen::MatrixXd& Z, const LayerParams&
       f.t_max = std::max(f.t_max, S[i][k] - S[i + 1][k]);
     }
   }
-  if (!with_rise) return f;
   // Rise under the head, on a 2D subgrid of about 1 mm: for each patch point p, how far a
   // point q of the same layer within the head's reach rises above what the head allows there
   // (its block allowance at q − p; the cone is the slope limit's). Offsets are sorted by
@@ -525,10 +467,6 @@ StackResult finish_stack(StackStart s, const TriangleMesh& mesh, const Patch& pa
   std::optional<double> start;
   Eigen::MatrixXd best = Z;
   bool moved = false;
-  const auto ok = [&](const Figures& g) {
-    return g.t_min >= p.min_layer_height - 1e-6 && g.t_max <= p.max_layer_height + 1e-6 &&
-           g.slope <= p.max_angle_deg;
-  };
   if (N >= 2 && p.max_iterations > 0) {
     std::vector<double> x(static_cast<std::size_t>(N - 1) * nc);
     for (int i = 1; i < N; ++i)
@@ -541,36 +479,24 @@ StackResult finish_stack(StackStart s, const TriangleMesh& mesh, const Patch& pa
     o.max_num_iterations = p.max_iterations;
     o.function_tolerance = 1e-7;
     o.logging_type = ceres::SILENT;
-    o.update_state_every_iteration = true;
     nurbs::SolverProgress stop(ctx, "", 0, 0, p.max_iterations);
     o.callbacks.push_back(&stop);
-    // The cost falls fastest in the first few steps, and then the solver, which knows no limits,
-    // steps past one (the sphere's: 368 -> 272 in one step, 217 in five, a layer beyond the
-    // limits by twenty; all 100 were thrown away for the even interpolation). Now the
-    // last step within the limits (measured as below) is kept and the solver stops at the
-    // first beyond them (WithinLimits).
-    const auto within = [&](const std::vector<double>& at) {
-      Eigen::MatrixXd Zi = Z;
-      for (int i = 1; i < N; ++i)
-        for (int j = 0; j < nc; ++j) Zi(i, j) = at[(i - 1) * nc + j];
-      return ok(measure(grid, Zi, p, H, dH, st.c, false));
-    };
-    std::vector<double> kept = x0;
-    WithinLimits limits(within, x, kept, within(x0));
-    o.callbacks.push_back(&limits);
     ceres::GradientProblemSolver::Summary sum;
     ceres::Solve(o, problem, x.data(), &sum);
-    limits.finish();
     st.iterations = static_cast<int>(sum.iterations.size()) - 1;
-    st.optimizer_message = limits.stopped() ? "stopped where a step broke a limit" : sum.message;
-    moved = kept != x0;
+    st.optimizer_message = sum.message;
+    moved = x != x0;
     for (int i = 1; i < N; ++i)
-      for (int j = 0; j < nc; ++j) best(i, j) = kept[(i - 1) * nc + j];
+      for (int j = 0; j < nc; ++j) best(i, j) = x[(i - 1) * nc + j];
   }
   st.cost_before = start ? *start : printability_cost(coarse, Z, terms, nullptr);
   st.cost_after = moved ? printability_cost(coarse, best, terms, nullptr) : st.cost_before;
   st.cost_optimised = st.cost_after;
   Figures f = measure(grid, best, p, H, dH, st.c);
+  const auto ok = [&](const Figures& g) {
+    return g.t_min >= p.min_layer_height - 1e-6 && g.t_max <= p.max_layer_height + 1e-6 &&
+           g.slope <= p.max_angle_deg;
+  };
   if (!ok(f) || !(st.cost_after <= st.cost_before)) {
     // The optimiser traded a limit for cost (or did not get there): keep the paper's even
     // interpolation, which meets the limits by the choice of c and N.
