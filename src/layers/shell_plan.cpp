@@ -141,6 +141,7 @@ void take_region(ShellPlan& s, ShellRegion&& r) {
     s.left_out = buf;
     for (std::size_t k = 0; k < r.why_out.size(); ++k) s.left_out += (k ? "; " : "") + r.why_out[k];
   }
+  s.banded = r.banded;
   s.region = std::move(r.mask);
   s.slack = std::move(r.slack);
   s.levels = std::move(r.levels);
@@ -387,7 +388,10 @@ std::vector<ShellPlan> choose_shells(const TriangleMesh& mesh, const Analysis& a
   return choose_shells(mesh, a, p, c);
 }
 
-std::vector<ShellPlan> choose_shells(const TriangleMesh& mesh, const Analysis& a,
+namespace {
+
+// choose_shells as the settings say.
+std::vector<ShellPlan> shells_as_set(const TriangleMesh& mesh, const Analysis& a,
                                      const LayerParams& p, const ShellChoice& c) {
   const int most = c.most;
   std::vector<ShellPlan> shells;
@@ -441,6 +445,42 @@ std::vector<ShellPlan> choose_shells(const TriangleMesh& mesh, const Analysis& a
       shells.push_back(std::move(s));
   }
   return shells;
+}
+
+}  // namespace
+
+std::vector<ShellPlan> choose_shells(const TriangleMesh& mesh, const Analysis& a,
+                                     const LayerParams& p, const ShellChoice& c) {
+  std::vector<ShellPlan> shells = shells_as_set(mesh, a, p, c);
+  // A shell banded over more than half of its patches is worth its bands (their print time,
+  // and the slab over the whole part, 2.6 s of the bunny's 5.5 s slice) only where shells
+  // over the regions apart, each banded less, leave a good part of it planar: the bunny's four
+  // cover 84 % of its curved area (82.3 % of the top within 0.03 mm against the banded one's
+  // 82.9 %, in 2.9 s against 5.5), two reliefs' two all of it; the ankle base's inner ring
+  // alone 57 % (72 % against 81 %), the ornament's cap 52 % (53 % against 70 %).
+  constexpr double kBandedShare = 0.5, kCovered = 0.8;
+  const ShellPlan& first = shells.front();
+  if (!first.refused.empty() || first.banded <= kBandedShare || p.shell_max_banded <= kBandedShare)
+    return shells;
+  LayerParams less = p;
+  less.shell_max_banded = kBandedShare;
+  std::vector<ShellPlan> apart = shells_as_set(mesh, a, less, c);
+  if (!apart.front().refused.empty()) return shells;
+  auto area = [&](const std::vector<ShellPlan>& plans) {
+    double sum = 0;
+    for (const ShellPlan& s : plans)
+      for (int i : s.patches) sum += a.patches[static_cast<std::size_t>(i)].area;
+    return sum;
+  };
+  const double covered = area(apart) / area(shells);
+  if (covered < kCovered) return shells;
+  // Its notice names the setting the user did not set: say what was weighed instead.
+  char instead[80];
+  std::snprintf(instead, sizeof instead, "shells apart follow %.0f %% of its area", 100 * covered);
+  std::string& why = apart.front().narrowed;
+  if (const auto k = why.find("shell_max_banded 0.50"); k != std::string::npos)
+    why.replace(k, std::string("shell_max_banded 0.50").size(), instead);
+  return apart;
 }
 
 std::vector<ShellPlan> choose_shells_beside(const TriangleMesh& mesh, const Analysis& a,

@@ -44,6 +44,7 @@ struct ShellPlan {
   ShellLevels levels;   ///< g (shell_levels.hpp)
   double below = 0;     ///< the bound of s⁻, min(t − a, h/2) − 0.01, mm
   bool framed = false;  ///< H covers only the patches' surroundings (plan_shell's frame)
+  double banded = 0;    ///< the share of the patches printed in bands (shell_region.hpp)
   /// What of the patches the shell leaves to the core because an overhang or another surface
   /// lies under it there, and why (empty: none).
   std::string left_out;

@@ -223,6 +223,12 @@ TEST(ShellPlan, RefusesAShellMostlyPrintedInBands) {
   const layers::ShellPlan both = layers::plan_shell(m->mesh, a, {0, 1}, any);
   EXPECT_TRUE(both.refused.empty()) << both.refused;
   EXPECT_EQ(layers::choose_shell(m->mesh, a, any).patches, (std::vector<int>{0, 1}));
+  // choose_shells weighs the banded shell against shells apart: the inner ring alone follows
+  // 57 % of the curved area, so the banded one is kept.
+  const std::vector<layers::ShellPlan> chosen = layers::choose_shells(m->mesh, a, any);
+  ASSERT_EQ(chosen.size(), 1u);
+  EXPECT_EQ(chosen.front().patches, (std::vector<int>{0, 1}));
+  EXPECT_NEAR(chosen.front().banded, 0.69, 0.01);
 }
 
 }  // namespace
