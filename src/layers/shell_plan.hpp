@@ -100,7 +100,10 @@ ShellPlan choose_shell(const TriangleMesh& mesh, const Analysis& a, const LayerP
 /// its largest patch alone. A further shell is kept when its patches' box lies farther than
 /// the head's reach from every kept shell's patches, and it plans with R not everywhere, on
 /// the same core. The bunny's back, head, ear and tail: four shells. At most `most` shells
-/// (and as many groups tried); the first may be refused (nothing else then).
+/// (and as many groups tried); the first may be refused (nothing else then). A first shell
+/// banded over more than half of its patches (p.shell_max_banded allowing it) is weighed
+/// against the shells chosen as at shell_max_banded 0.5: those win when they follow at least
+/// 80 % of its patches' area.
 std::vector<ShellPlan> choose_shells(const TriangleMesh& mesh, const Analysis& a,
                                      const LayerParams& p, int most = 4);
 
