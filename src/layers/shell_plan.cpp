@@ -459,8 +459,8 @@ std::vector<ShellPlan> choose_shells(const TriangleMesh& mesh, const Analysis& a
   // 82.9 %, in 2.9 s against 5.5), two reliefs' two all of it; the ankle base's inner ring
   // alone 57 % (72 % against 81 %), the ornament's cap 52 % (53 % against 70 %).
   // With one shell at most (through another slicer: its one run prints no shell that the part
-  // stands above, banded or not), there is nothing to weigh: the bunny's banded plan was
-  // planned three times, 1 s of the engine route's 9.6.
+  // stands above, banded or not), there is nothing to weigh (the bunny's banded plan, dropped
+  // for its size, was planned three times).
   constexpr double kBandedShare = 0.5, kCovered = 0.8;
   if (const ShellPlan& first = shells.front(); c.most < 2 || !first.refused.empty() ||
                                                first.banded <= kBandedShare ||

@@ -162,12 +162,13 @@ Expected<std::vector<LayerToolpaths>> make_toolpaths(const std::vector<SlicedLay
     }
     std::vector<ExtrusionPath> islands_paths;
     const double angle = P.fill_angle + (i % 2 ? 90.0 : 0.0);
-    // Solid fill (spacing s) is fitted to each island; a line spaced d wide is w + d − s wide.
+    // Solid fill (spacing s) is fitted to each island; a line spaced d instead of `spacing` is
+    // w + d − spacing wide (on the global grid d is `spacing`).
     auto add_lines = [&](const ExPolygons& region, ExtrusionRole role, double spacing, double ang,
                          double v) {
       for (const auto& l : paths::infill_lines(region, ang, spacing, s, spacing == s))
-        islands_paths.push_back(make_path(role, w + (spacing == s ? l.spacing - s : 0.0), speed(v),
-                                          l.line, false, z, h));
+        islands_paths.push_back(
+            make_path(role, w + (l.spacing - spacing), speed(v), l.line, false, z, h));
     };
     add_lines(exposed, ExtrusionRole::top_solid_infill, s, angle, P.top_solid_infill_speed);
     add_lines(solid_inner, ExtrusionRole::solid_infill, s, angle, P.solid_infill_speed);
