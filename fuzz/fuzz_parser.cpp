@@ -157,9 +157,22 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     gaps.finish();
   }
   (void)parse_ini_config(gcode_config_block(in));  // what `check` reads of a file's settings
+  // Read a piece at a time (the mapping's reading), the same lines and moves.
+  const GcodeProgram whole = read_gcode_program(in);
+  GcodePieceReader pieces(in);
+  std::size_t lines = 0, moves = 0;
+  while (pieces.next(1))
+    lines += pieces.program().lines.size(), moves += pieces.program().moves.size();
+  if (lines != whole.lines.size() || moves != whole.moves.size()) __builtin_trap();
 #elif NONPLANAR_FUZZ_PARSER == 8
   static const Wave field;
-  (void)map_foreign_gcode(in, field, {}, {});
+  // A layer at a time or 64 (the default), the same file.
+  const auto mapped = map_foreign_gcode(in, field, {}, {});
+  ForeignMapOptions one_layer;
+  one_layer.layers_at_once = 1;
+  const auto again = map_foreign_gcode(in, field, {}, {}, one_layer);
+  if (mapped.ok() != again.ok() || (mapped && mapped->text() != again->text()))
+    __builtin_trap();
   static const Waves clip;
   ForeignMapOptions o;
   o.clip = &clip;

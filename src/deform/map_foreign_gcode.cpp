@@ -1,8 +1,9 @@
 // Mapping another slicer's planar G-code of the normalised mesh back onto the curved layers
 // (issue: libslic3r engine). Notation as in map_segment.hpp; E is filament length (mm).
 //
-// The file is read by the one reader (program.hpp) and keeps its own program: start and end
-// G-code, temperatures, fan, speeds and retractions pass untouched. Inside the print (first
+// The file is read by the one reader (program.hpp), a piece at a time (GcodePieceReader: the
+// start, a window of layers, the end), and keeps its own program: start and end G-code,
+// temperatures, fan, speeds and retractions pass untouched. Inside the print (first
 // ;LAYER_CHANGE to the ;TYPE:Custom that follows the last typed extrusion), a layer at a time:
 // its extrusions are cut back under a shell if asked (clip_layer), mapped like the built-in
 // engine's paths (resampled, each piece's E scaled by its own 3D length and layer thickness
@@ -132,15 +133,6 @@ void add_travel(const GcodeMove& m, const LayerField& field, const MapBackParams
   s.at = to;
 }
 
-// Cells over where the print's moves go, with room for the mapping's few millimetres.
-program::PrintedTop printed_top_over(const GcodeProgram& prog) {
-  BoundingBox b;
-  for (const GcodeMove& m : prog.moves)
-    if (m.layer >= 0) b.extend(m.from), b.extend(m.to);
-  if (b.empty()) return {};
-  return program::PrintedTop(b.min.head<2>() - Vec2(5, 5), b.max.head<2>() + Vec2(5, 5));
-}
-
 // One mapped layer as steps (s.layer); ;Z: becomes its highest point and ;HEIGHT: its mean
 // thickness (planar_h when it extrudes nothing).
 void build_layer(const LayerWork& work, const LayerField& field, const MapBackParams& params,
@@ -203,19 +195,6 @@ struct InOrder {
   std::size_t clip_samples = 0, points = 0;
 };
 
-// `mapped` holds the moves of lines [begin, end) (the read program's: passes add theirs after).
-void window_moves(const std::vector<GcodeLine>& lines, std::size_t begin, std::size_t end,
-                  program::MovePaths& mapped) {
-  std::size_t lo = 0, hi = 0;
-  for (std::size_t l = begin; l < end; ++l)
-    if (lines[l].kind == Kind::move) {
-      const auto m = static_cast<std::size_t>(lines[l].move);
-      if (lo == hi) lo = m;
-      hi = m + 1;
-    }
-  mapped.window(lo, hi);
-}
-
 // One layer: cut back under the shell (options.clip), mapped (unless `premapped`, its point
 // count from map_gcode_layers, says it is), top skins ordered, built as steps and written.
 std::optional<Error> write_layer(InOrder& o, const GcodeLayerSpan& span,
@@ -271,10 +250,47 @@ std::optional<Error> write_layer(InOrder& o, const GcodeLayerSpan& span,
   return std::nullopt;
 }
 
+// The layers of one piece of the print (all of it when clipped), mapped and written in order.
+std::optional<Error> write_piece(InOrder& o, const Context& ctx) {
+  GcodeProgram& prog = o.prog;
+  const std::vector<GcodeLine>& lines = prog.lines;
+  const std::vector<GcodeLayerSpan> spans = gcode_layer_spans(lines);
+  o.mapped = program::MovePaths(prog.moves.size());
+  o.mapped.window(0, prog.moves.size());
+  // Nothing cut away: the layers are independent until their passes, and are mapped side by
+  // side first (the bunny from PrusaSlicer, 1000 layers: map back 2.02 s -> 1.54 s), and a
+  // layer's mapped moves go once it is written (they were all held at once: the bunny's map
+  // back rose 200 MB over the rest of the slice's peak).
+  std::vector<std::size_t> premapped;
+  if (!o.options.clip)
+    premapped = map_gcode_layers(lines, spans, prog.moves, o.mapped, o.field, o.params,
+                                 o.options.planar_lines, o.out.layers, ctx);
+  for (std::size_t k = 0; k < spans.size(); ++k) {
+    if (ctx.cancelled()) return Error{Status::cancelled, "cancelled"};
+    std::string& text = o.s.w.out;
+    if (text.capacity() - text.size() < (std::size_t{1} << 20))
+      reserve_text(text, 2 * text.capacity());
+    if (auto e = write_layer(o, spans[k],
+                             premapped.empty() ? std::nullopt : std::optional(premapped[k])))
+      return e;
+    for (std::size_t l = spans[k].begin; l < spans[k].end; ++l)
+      if (lines[l].kind == Kind::move) o.mapped[static_cast<std::size_t>(lines[l].move)] = {};
+  }
+  return std::nullopt;
+}
+
 }  // namespace
 
 std::string ForeignGcode::take_text(std::string_view head) {
-  std::string t = joined_huge({head, start, print, end});
+  // In the print's own room (reserved twice the slicer's file, map_foreign_gcode) when the rest
+  // fits there: a joined copy held the bunny's 28.6 MB twice at the engine route's peak.
+  std::string t = std::move(print);
+  if (t.capacity() - t.size() < head.size() + start.size() + end.size()) {
+    t = joined_huge({head, start, t, end});
+  } else {
+    t.insert(0, std::string(head) + start);
+    t += end;
+  }
   start = std::string(), print = std::string(), end = std::string();
   return t;
 }
@@ -283,78 +299,59 @@ Expected<ForeignGcode> map_foreign_gcode(std::string_view text, const LayerField
                                          const MapBackParams& params, const Context& ctx,
                                          const ForeignMapOptions& options) {
   if (!(params.tolerance > 0)) return Error{Status::invalid_argument, "map tolerance: must be > 0"};
-  GcodeProgram prog = read_gcode_program(text);
-  const std::vector<GcodeLine>& lines = prog.lines;
-  if (prog.print_begin == lines.size())
+  // Read a piece at a time: the start, a window of layers (all of them when clipped: a clip
+  // needs the file's retraction), the end. Held whole, the bunny's lines and moves through
+  // PrusaSlicer were 118 MB of the engine route's peak.
+  GcodePieceReader reader(text);
+  GcodeProgram& prog = reader.program();
+  if (reader.layer_count() == 0)
     return Error{Status::parse_error, "no ;LAYER_CHANGE: not a layered G-code file"};
-  if (auto e = first_unmappable(prog)) return *e;
+  reader.next(0);  // the start
   if (ctx.cancelled()) return Error{Status::cancelled, "cancelled"};
 
   ForeignGcode out;
-  out.layers.resize(prog.layer_height.size());
-  Writing s(GcodeText(prog.at_print.relative_e, prog.at_print.e), printed_top_over(prog));
-  program::MovePaths mapped(prog.moves.size());  // a window's moves, and those the passes add
-  std::size_t i = 0;
-  for (; i < prog.print_begin; ++i) s.w.raw(lines[i].raw);
+  Writing s(GcodeText(prog.at_print.relative_e, prog.at_print.e), program::PrintedTop());
+  for (const GcodeLine& l : prog.lines) s.w.raw(l.raw);
   out.start = std::move(s.w.out);
   s.w.out.clear();
-  // The print's text, mapped, in huge-page-advised room (grown by doubling, each larger buffer's
-  // pages faulted in again, 4 KiB at a time): twice the slicer's to start with (the bunny's
-  // 19 MB from PrusaSlicer map to 28.6 MB; a small part's curved layers, resampled, to up to 13
-  // times its file), then doubled before a layer when less than a MiB is left.
-  if (prog.print_begin < lines.size()) {
-    const auto from = static_cast<std::size_t>(lines[prog.print_begin].raw.data() - text.data());
-    reserve_text(s.w.out, 2 * (text.size() - from) + 4096);
-  }
   out.relative_e_at_print = prog.at_print.relative_e, out.e_at_print = prog.at_print.e;
   out.fan_at_print = std::string(prog.fan_at_print);
-  for (std::size_t k = prog.print_begin; k < prog.print_end; ++k)
-    if (lines[k].kind == Kind::move) {
-      s.at = prog.moves[static_cast<std::size_t>(lines[k].move)].from;
-      break;
-    }
-  if (options.start) s.at = *options.start;
   s.pending = options.start_retracted;
-  std::vector<char> dropped(prog.layer_height.size(), 0);
-  const std::vector<GcodeLayerSpan> spans = gcode_layer_spans(prog);
-  // Nothing cut away: the layers are independent until their passes, and are mapped side by
-  // side first (the bunny from PrusaSlicer, 1000 layers: map back 2.02 s -> 1.54 s), a window
-  // of layers at a time, and a layer's mapped moves go once it is written (they were all held
-  // at once: the bunny's map back rose 200 MB over the rest of the slice's peak); `mapped`
-  // holds the window's moves only.
-  const std::size_t window =
-      options.clip ? spans.size() : std::max<std::size_t>(1, options.layers_at_once);
+  std::vector<char> dropped;
+  program::MovePaths mapped(0);
   InOrder o{prog, mapped, field, params, options, out, s, dropped};
-  for (std::size_t k0 = 0; k0 < spans.size(); k0 += window) {
-    const std::size_t k1 = std::min(spans.size(), k0 + window);
-    window_moves(lines, spans[k0].begin, spans[k1 - 1].end, mapped);
-    std::vector<std::size_t> premapped;
-    if (!options.clip)
-      premapped = map_gcode_layers(
-          lines, {spans.begin() + static_cast<long>(k0), spans.begin() + static_cast<long>(k1)},
-          prog.moves, mapped, field, params, options.planar_lines, out.layers, ctx);
-    for (std::size_t k = k0; k < k1; ++k) {
-      if (ctx.cancelled()) return Error{Status::cancelled, "cancelled"};
-      if (s.w.out.capacity() - s.w.out.size() < (std::size_t{1} << 20))
-        reserve_text(s.w.out, 2 * s.w.out.capacity());
-      if (auto e = write_layer(o, spans[k],
-                               premapped.empty() ? std::nullopt : std::optional(premapped[k - k0])))
-        return *e;
-      for (std::size_t l = spans[k].begin; l < spans[k].end; ++l)
-        if (lines[l].kind == Kind::move) mapped[static_cast<std::size_t>(lines[l].move)] = {};
+  const std::size_t window =
+      options.clip ? reader.layer_count() : std::max<std::size_t>(1, options.layers_at_once);
+  bool placed = false, first = true;
+  while (reader.next(window) && reader.piece() == GcodePieceReader::Piece::layers) {
+    if (auto e = first_unmappable(prog)) return *e;
+    if (ctx.cancelled()) return Error{Status::cancelled, "cancelled"};
+    out.layers.resize(std::max(out.layers.size(), prog.layer_height.size()));
+    dropped.resize(out.layers.size(), 0);
+    // The print's text, mapped, in huge-page-advised room (grown by doubling, each larger
+    // buffer's pages faulted in again, 4 KiB at a time): twice the slicer's to start with (the
+    // bunny's 19 MB from PrusaSlicer map to 28.6 MB; a small part's curved layers, resampled,
+    // to up to 13 times its file), then doubled before a layer when less than a MiB is left.
+    if (first && !prog.lines.empty()) {
+      const auto from = static_cast<std::size_t>(prog.lines[0].raw.data() - text.data());
+      reserve_text(s.w.out, 2 * (text.size() - from) + 4096);
     }
+    first = false;
+    // The nozzle starts where the print's first move starts, or where the caller says.
+    if (options.start && !placed) s.at = *options.start, placed = true;
+    for (std::size_t l = 0; l < prog.lines.size() && !placed; ++l)
+      if (prog.lines[l].kind == Kind::move)
+        s.at = prog.moves[static_cast<std::size_t>(prog.lines[l].move)].from, placed = true;
+    if (auto e = write_piece(o, ctx)) return *e;
   }
   if (ctx.cancelled()) return Error{Status::cancelled, "cancelled"};
-  i = prog.print_end;
   out.print = std::move(s.w.out);
   s.w.out.clear();
   out.end_at = s.at, out.retracted = s.retracted, out.relative_e_at_end = prog.at_end.relative_e;
   // The end G-code as written, after telling the firmware the file's own E (absolute E).
-  if (prog.print_end < lines.size() && !prog.at_end.relative_e)
-    s.w.line("G92 E%.5f", prog.at_end.e);
-  if (prog.print_end < lines.size() && prog.at_end.relative_xyz)
-    s.w.raw("G91 ; as the file had it here");
-  for (; i < lines.size(); ++i) s.w.raw(lines[i].raw);
+  if (!prog.lines.empty() && !prog.at_end.relative_e) s.w.line("G92 E%.5f", prog.at_end.e);
+  if (!prog.lines.empty() && prog.at_end.relative_xyz) s.w.raw("G91 ; as the file had it here");
+  for (const GcodeLine& l : prog.lines) s.w.raw(l.raw);
   if (s.w.fault) return *s.w.fault;
   out.end = std::move(s.w.out);
   for (std::size_t k = dropped.size(); k-- > 0;)

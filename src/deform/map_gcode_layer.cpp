@@ -47,12 +47,12 @@ std::optional<Error> map_gcode_layer(std::span<const GcodeLine> lines,
   return std::nullopt;
 }
 
-std::vector<GcodeLayerSpan> gcode_layer_spans(const GcodeProgram& prog) {
+std::vector<GcodeLayerSpan> gcode_layer_spans(std::span<const GcodeLine> lines) {
   std::vector<GcodeLayerSpan> spans;
-  for (std::size_t i = prog.print_begin; i < prog.print_end;) {
+  for (std::size_t i = 0; i < lines.size();) {
     std::size_t j = i + 1;
-    while (j < prog.print_end && prog.lines[j].raw.rfind(";LAYER_CHANGE", 0) != 0) ++j;
-    spans.push_back({i, j, static_cast<std::size_t>(std::max(prog.lines[i].layer, 0))});
+    while (j < lines.size() && lines[j].raw.rfind(";LAYER_CHANGE", 0) != 0) ++j;
+    spans.push_back({i, j, static_cast<std::size_t>(std::max(lines[i].layer, 0))});
     i = j;
   }
   return spans;

@@ -34,9 +34,9 @@ struct GcodeLayerSpan {
   std::size_t begin = 0, end = 0, layer = 0;
 };
 
-/// The print's layers (prog.print_begin to print_end), each from its ;LAYER_CHANGE to the
-/// next.
-std::vector<GcodeLayerSpan> gcode_layer_spans(const GcodeProgram& prog);
+/// The layers of a run of whole layers of the print (a piece GcodePieceReader read), each from
+/// its ;LAYER_CHANGE to the next; begin and end index `lines`.
+std::vector<GcodeLayerSpan> gcode_layer_spans(std::span<const GcodeLine> lines);
 
 /// map_gcode_layers' count for a layer it did not finish.
 inline constexpr std::size_t kFailed = static_cast<std::size_t>(-1);

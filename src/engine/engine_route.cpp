@@ -42,6 +42,7 @@ Expected<EngineOutput> external(const TriangleMesh& to_slice, const LayerField* 
     e.message = "engine G-code, " + e.message;
     return e;
   }
+  std::string().swap(*text);  // (the mapped program holds no view of it)
   EngineOutput out;
   out.layers = std::move(mapped->layers);
   out.gcode = mapped->take_text();

@@ -27,11 +27,38 @@ void PrintedTop::lay(const Vec3& a, const Vec3& b) {
   for (int k = 0; k <= n; ++k) lay(a + (b - a) * (static_cast<double>(k) / n));
 }
 
+bool PrintedTop::grow(const Vec2& p) {
+  if (!p.allFinite() || p.cwiseAbs().maxCoeff() > 1e6) return false;
+  if (top_.empty()) lo_ = (p / kCell).array().floor().matrix() * kCell, nx_ = ny_ = 0;
+  // The cells' index box, grown over p with room to spare (16 mm, or half again the side it
+  // grows: a file's beads come a few at a time, each growth copies the grid).
+  long i0 = 0, j0 = 0, i1 = nx_, j1 = ny_;  // [i0, i1) x [j0, j1) in the old cells' indices
+  const auto fi = static_cast<long>(std::floor((p.x() - lo_.x()) / kCell)),
+             fj = static_cast<long>(std::floor((p.y() - lo_.y()) / kCell));
+  const long mx = std::max(16L, long{nx_} / 2), my = std::max(16L, long{ny_} / 2);
+  if (fi < i0) i0 = fi - mx;
+  if (fi >= i1) i1 = fi + 1 + mx;
+  if (fj < j0) j0 = fj - my;
+  if (fj >= j1) j1 = fj + 1 + my;
+  const long nx = i1 - i0, ny = j1 - j0;
+  if (nx > 4096 || ny > 4096 || nx * ny > kMostCells) return false;
+  std::vector<float> top(static_cast<std::size_t>(nx * ny),
+                         -std::numeric_limits<float>::infinity());
+  for (long i = 0; i < nx_; ++i)
+    std::copy_n(top_.begin() + i * ny_, ny_, top.begin() + (i - i0) * ny - j0);
+  top_ = std::move(top);
+  lo_ += Vec2(static_cast<double>(i0) * kCell, static_cast<double>(j0) * kCell);
+  nx_ = static_cast<int>(nx), ny_ = static_cast<int>(ny);
+  return true;
+}
+
 void PrintedTop::lay(const Vec3& p) {
   highest_ = std::max(highest_, p.z());
-  const double fx = std::floor((p.x() - lo_.x()) / kCell),
-               fy = std::floor((p.y() - lo_.y()) / kCell);
-  if (!(fx >= 0 && fy >= 0 && fx < nx_ && fy < ny_)) return;
+  double fx = std::floor((p.x() - lo_.x()) / kCell), fy = std::floor((p.y() - lo_.y()) / kCell);
+  if (!(fx >= 0 && fy >= 0 && fx < nx_ && fy < ny_)) {
+    if (!grow(p.head<2>())) return;
+    fx = std::floor((p.x() - lo_.x()) / kCell), fy = std::floor((p.y() - lo_.y()) / kCell);
+  }
   float& t = top_[static_cast<std::size_t>(fx) * static_cast<std::size_t>(ny_) +
                   static_cast<std::size_t>(fy)];
   t = std::max(t, static_cast<float>(p.z()));

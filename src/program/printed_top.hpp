@@ -16,8 +16,11 @@ inline constexpr double kTravelCorridor = 1.0;
 
 class PrintedTop {
  public:
-  PrintedTop() = default;  ///< no cells: over() finds nothing
-  /// Cells over [lo, hi] (mm, XY), 1 mm square; points off it are not kept.
+  /// No cells yet: they are made round the first bead laid. Cells lie on a 1 mm lattice from
+  /// (0, 0) then, and are added (the grid grown) for a bead laid off them, up to 4096 cells on
+  /// a side; a point past that is not kept.
+  PrintedTop() = default;
+  /// Cells over [lo, hi] (mm, XY) to start with, 1 mm square, on the lattice from lo.
   PrintedTop(const Vec2& lo, const Vec2& hi);
   /// A bead laid from a to b (the nozzle's tip, mm): every cell it crosses.
   void lay(const Vec3& a, const Vec3& b);
@@ -31,7 +34,9 @@ class PrintedTop {
 
  private:
   void lay(const Vec3& p);
-  Vec2 lo_;
+  /// Makes cells over p, keeping the lattice and what was laid; false when it cannot.
+  bool grow(const Vec2& p);
+  Vec2 lo_{0, 0};
   double highest_ = -std::numeric_limits<double>::infinity();
   int nx_ = 0, ny_ = 0;
   std::vector<float> top_;  ///< nx × ny, -inf where nothing is laid

@@ -63,22 +63,29 @@ bool is_m_number(std::string_view n) {
                                        : digits(n.substr(0, dot)) && digits(n.substr(dot + 1));
 }
 
+// The line of text that starts at byte `at` (without its line end); `at` moves past it.
+std::string_view next_line(std::string_view text, std::size_t& at) {
+  std::size_t end = text.find('\n', at);
+  if (end == std::string_view::npos) end = text.size();
+  std::string_view l = text.substr(at, end - at);
+  if (!l.empty() && l.back() == '\r') l.remove_suffix(1);
+  at = end + 1;
+  return l;
+}
+
 // Calls f(i, line) for each line of text (without its line end), i from 0.
 template <class F>
 void for_each_line(std::string_view text, F&& f) {
   std::size_t i = 0;
-  for (std::size_t start = 0; start < text.size(); ++i) {
-    std::size_t end = text.find('\n', start);
-    if (end == std::string_view::npos) end = text.size();
-    std::string_view l = text.substr(start, end - start);
-    if (!l.empty() && l.back() == '\r') l.remove_suffix(1);
+  for (std::size_t at = 0; at < text.size(); ++i) {
+    const std::string_view l = next_line(text, at);
     f(i, l);
-    start = end + 1;
   }
 }
 
 // Reads a whole text into p, or, with a sink, hands every move to it and keeps no lines or
-// moves (p then holds the problems and the per-file figures only).
+// moves (p then holds the problems and the per-file figures only); or, begun and then read
+// to one line after another, a piece at a time (GcodePieceReader).
 class Reader {
  public:
   using Sink = std::function<void(const GcodeMove&)>;
@@ -86,6 +93,15 @@ class Reader {
   Reader(GcodeProgram& p, const Sink* sink, const LineSink* lines = nullptr)
       : p_(p), sink_(sink), line_sink_(lines) {}
   void run(std::string_view text);
+  /// Counts the lines and finds the print; nothing is read yet.
+  void begin(std::string_view text);
+  /// Reads on up to line `end` (0-based, not included).
+  void read_to(std::size_t end);
+  std::size_t lines() const { return n_; }
+  std::size_t at_line() const { return i_; }
+  const GcodeState& state() const { return s_; }
+  /// The ;LAYER_CHANGE lines of the print (each starts one of its layers).
+  const std::vector<std::size_t>& layer_lines() const { return layer_lines_; }
 
  private:
   void comment(std::string_view c, std::size_t semi, GcodeLine& item, bool in_print);
@@ -102,8 +118,11 @@ class Reader {
   GcodeProgram& p_;
   const Sink* sink_;
   const LineSink* line_sink_;
-  GcodeMove last_;     // with line_sink_: the move of the line being read
-  std::size_t n_ = 0;  // lines in the file
+  GcodeMove last_;  // with line_sink_: the move of the line being read
+  std::string_view text_;
+  std::size_t n_ = 0;           // lines in the file
+  std::size_t i_ = 0, at_ = 0;  // the next line to read, and its first byte
+  std::vector<std::size_t> layer_lines_;
   int line_ = 0;
   Vec3 pos_{0, 0, 0};
   GcodeState s_;
@@ -123,30 +142,42 @@ class Reader {
 
 void Reader::run(std::string_view text) {
   const GcodeLineCount n = count_gcode_lines(text);
-  n_ = n.lines;
-  find_print(text);
   // Reserved: grown by doubling, the bunny's 700 000 lines were copied over and over, and the
   // pages of each new block faulted in (a third of the reading). The moves get half as much
   // again for those the mapping's passes add (top skins' travels, pieces cut under a shell):
   // the first such move past the room doubled the vector, 82 MB more at the bunny's peak
   // through PrusaSlicer. Room never written is never resident.
-  const bool keep = !sink_ && !line_sink_;
-  if (keep)
+  if (!sink_ && !line_sink_)
     reserve_huge(p_.lines, n.lines), reserve_huge(p_.moves, n.g_lines + n.g_lines / 2 + 1024);
-  for_each_line(text, [&](std::size_t i, std::string_view l) {
+  begin(text);
+  read_to(n_);
+}
+
+void Reader::begin(std::string_view text) {
+  text_ = text;
+  n_ = count_gcode_lines(text).lines;
+  find_print(text);
+}
+
+void Reader::read_to(std::size_t end) {
+  const bool keep = !sink_ && !line_sink_;
+  for (; i_ < end && at_ < text_.size(); ++i_) {
     GcodeLine item;
-    item.raw = l;
-    read_line(i, item);
+    item.raw = next_line(text_, at_);
+    read_line(i_, item);
     if (line_sink_) (*line_sink_)(item, item.kind == Kind::move ? &last_ : nullptr);
     if (keep) p_.lines.push_back(item);
-  });
+  }
 }
 
 void Reader::find_print(std::string_view text) {
   std::size_t last_typed = 0, begin = std::string_view::npos;
   std::vector<std::size_t> custom;  // the ;TYPE:Custom lines
   for_each_line(text, [&](std::size_t i, std::string_view l) {
-    if (begin == std::string_view::npos && l.rfind(";LAYER_CHANGE", 0) == 0) begin = i;
+    if (l.rfind(";LAYER_CHANGE", 0) == 0) {
+      if (begin == std::string_view::npos) begin = i;
+      layer_lines_.push_back(i);
+    }
     if (l.rfind(";TYPE:Custom", 0) == 0)
       custom.push_back(i);
     else if (l.rfind(";TYPE:", 0) == 0)
@@ -160,6 +191,7 @@ void Reader::find_print(std::string_view text) {
       p_.print_end = i;
       break;
     }
+  std::erase_if(layer_lines_, [&](std::size_t i) { return i >= p_.print_end; });
 }
 
 void Reader::read_line(std::size_t i, GcodeLine& item) {
@@ -346,6 +378,58 @@ GcodeProgram read_gcode_program(std::string_view text) {
   GcodeProgram p;
   Reader(p, nullptr).run(text);
   return p;
+}
+
+struct GcodePieceReader::Impl {
+  explicit Impl(std::string_view text) : reader(p, nullptr) { reader.begin(text); }
+  GcodeProgram p;
+  Reader reader;
+  Piece piece = Piece::start;
+  bool started = false;
+  std::size_t first = 0, next_layer = 0;
+};
+
+GcodePieceReader::GcodePieceReader(std::string_view text) : impl_(std::make_unique<Impl>(text)) {}
+GcodePieceReader::~GcodePieceReader() = default;
+
+bool GcodePieceReader::next(std::size_t layers) {
+  Impl& m = *impl_;
+  const std::vector<std::size_t>& at = m.reader.layer_lines();
+  std::size_t to = m.reader.lines();
+  if (!m.started) {
+    m.started = true, to = m.p.print_begin;
+  } else if (m.piece == Piece::start || (m.piece == Piece::layers && m.next_layer < at.size())) {
+    if (m.next_layer == at.size()) {
+      m.piece = Piece::end;  // no layers: the end follows the start
+    } else {
+      m.piece = Piece::layers;
+      m.next_layer = std::min(at.size(), m.next_layer + std::max<std::size_t>(layers, 1));
+      to = m.next_layer < at.size() ? at[m.next_layer] : m.p.print_end;
+    }
+  } else if (m.piece == Piece::layers) {
+    m.piece = Piece::end;
+  } else {
+    return false;
+  }
+  m.p.lines.clear(), m.p.moves.clear(), m.p.problems.clear();
+  m.first = m.reader.at_line();
+  m.reader.read_to(to);
+  if (m.piece == Piece::start && m.p.print_begin < m.reader.lines())
+    m.p.at_print = m.reader.state();
+  return true;
+}
+
+GcodePieceReader::Piece GcodePieceReader::piece() const {
+  return impl_->piece;
+}
+std::size_t GcodePieceReader::first_line() const {
+  return impl_->first;
+}
+std::size_t GcodePieceReader::layer_count() const {
+  return impl_->reader.layer_lines().size();
+}
+GcodeProgram& GcodePieceReader::program() {
+  return impl_->p;
 }
 
 GcodeProgram for_each_gcode_line(std::string_view text,

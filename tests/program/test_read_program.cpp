@@ -2,8 +2,10 @@
 // move carries, what is a problem and where; the emitter's formats and E bookkeeping.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include "nonplanar/deform.hpp"
 #include "nonplanar/program.hpp"
@@ -258,6 +260,82 @@ TEST(ReadProgram, LinesAndGLinesCounted) {
     EXPECT_EQ(n.g_lines, c.g_lines) << c.text;
     EXPECT_EQ(read_gcode_program(c.text).lines.size(), c.lines) << c.text;
   }
+}
+
+// Read a piece at a time (the start, two layers at a time, the end), a file gives the lines,
+// moves, problems and figures the whole reading gives: the same kinds and values, the moves
+// indexed within their piece, the pieces' first lines where they are in the file.
+TEST(ReadProgram, PiecesReadAsTheWholeFile) {
+  std::string layers;
+  for (int k = 3; k <= 7; ++k) {
+    const std::string z = std::to_string(0.2 * k);
+    layers += ";LAYER_CHANGE\n;Z:" + z + "\n;HEIGHT:0.2\nG1 Z" + z + " F720\n" +
+              ";TYPE:Solid infill\nG1 X" + std::to_string(10 + k) + " Y20 E0.5\n";
+    if (k == 5) layers += "G2 X1 Y1 I1 J1\n";  // a problem, in the third piece
+  }
+  const std::string text = kPrusaStart + kPrint + layers + kEnd;
+  const GcodeProgram whole = read_gcode_program(text);
+  GcodePieceReader reader(text);
+  ASSERT_EQ(reader.layer_count(), 7u);
+  std::vector<GcodePieceReader::Piece> pieces;
+  std::size_t line = 0, move = 0, problem = 0;
+  while (reader.next(2)) {
+    const GcodeProgram& p = reader.program();
+    pieces.push_back(reader.piece());
+    EXPECT_EQ(reader.first_line(), line);
+    EXPECT_EQ(p.print_begin, whole.print_begin);
+    EXPECT_EQ(p.print_end, whole.print_end);
+    for (const GcodeLine& l : p.lines) {
+      const GcodeLine& w = whole.lines[line++];
+      EXPECT_EQ(l.raw, w.raw);
+      EXPECT_EQ(l.kind, w.kind) << l.raw;
+      EXPECT_EQ(l.value, w.value) << l.raw;
+      EXPECT_EQ(l.layer, w.layer) << l.raw;
+      if (l.kind != Kind::move) continue;
+      ASSERT_EQ(w.move, static_cast<int>(move++)) << l.raw;
+      const GcodeMove& a = p.moves.at(static_cast<std::size_t>(l.move));
+      const GcodeMove& b = whole.moves[static_cast<std::size_t>(w.move)];
+      EXPECT_EQ(a.from, b.from) << l.raw;
+      EXPECT_EQ(a.to, b.to) << l.raw;
+      EXPECT_EQ(a.de, b.de) << l.raw;
+      EXPECT_EQ(a.type, b.type) << l.raw;
+      EXPECT_EQ(a.height, b.height) << l.raw;
+      EXPECT_EQ(a.line, b.line) << l.raw;
+    }
+    EXPECT_EQ(p.moves.size(), static_cast<std::size_t>(std::count_if(
+                                  p.lines.begin(), p.lines.end(),
+                                  [](const GcodeLine& l) { return l.kind == Kind::move; })));
+    for (const GcodeProblem& q : p.problems) EXPECT_EQ(q.line, whole.problems.at(problem++).line);
+    if (reader.piece() != GcodePieceReader::Piece::start) {
+      EXPECT_EQ(p.at_print.e, whole.at_print.e);
+      EXPECT_EQ(p.at_print.relative_e, whole.at_print.relative_e);
+    }
+  }
+  EXPECT_EQ(line, whole.lines.size());
+  EXPECT_EQ(move, whole.moves.size());
+  EXPECT_EQ(problem, whole.problems.size());
+  ASSERT_EQ(problem, 2u);  // the start's G28 (home), the arc
+  using P = GcodePieceReader::Piece;
+  EXPECT_EQ(pieces, (std::vector<P>{P::start, P::layers, P::layers, P::layers, P::layers, P::end}));
+  const GcodeProgram& last = reader.program();
+  EXPECT_EQ(last.layer_z, whole.layer_z);
+  EXPECT_EQ(last.layer_height, whole.layer_height);
+  EXPECT_EQ(last.at_end.e, whole.at_end.e);
+  EXPECT_EQ(last.retraction.length, whole.retraction.length);
+  EXPECT_FALSE(reader.next(2));
+}
+
+// A file without layers is one start piece (the whole file), an empty end, and no more.
+TEST(ReadProgram, PiecesOfAFileWithoutLayers) {
+  GcodePieceReader reader(kPrusaStart);
+  EXPECT_EQ(reader.layer_count(), 0u);
+  ASSERT_TRUE(reader.next(64));
+  EXPECT_EQ(reader.piece(), GcodePieceReader::Piece::start);
+  EXPECT_EQ(reader.program().lines.size(), read_gcode_program(kPrusaStart).lines.size());
+  ASSERT_TRUE(reader.next(64));
+  EXPECT_EQ(reader.piece(), GcodePieceReader::Piece::end);
+  EXPECT_TRUE(reader.program().lines.empty());
+  EXPECT_FALSE(reader.next(64));
 }
 
 }  // namespace
