@@ -203,10 +203,7 @@ Expected<ShellStack> shell_stack(const TriangleMesh& placed, const layers::Shell
 Expected<EngineShell> shell_with_engine(const TriangleMesh& mesh, const layers::ShellPlan& plan,
                                         const EngineRoute& job, const Context& ctx) {
   // One engine run cannot stop its core part-way for the shell and go on after it.
-  if (!plan.region.empty())
-    return Error{Status::unsupported,
-                 "through an engine, a shell prints only where the part stands nowhere above "
-                 "its top (the built-in engine prints this one)"};
+  if (!plan.region.empty()) return Error{Status::unsupported, std::string(kEngineShellWhole)};
   // One run of the part with the shell's slab above its core, split where the core ends, as
   // post-process splits the slicer's file of a prepared shell. Two runs side by side (the
   // core, and the slab alone) took the whole process 1.36 s of CPU on the wing, this one 1.08.

@@ -12,6 +12,15 @@
 
 namespace nonplanar {
 
+/// Why a shell the part stands above is not printed by one slicer run (it cannot stop its core
+/// part-way for the shell's pieces): through an engine (`slice --engine`), and for prepare.
+inline constexpr std::string_view kEngineShellWhole =
+    "through an engine, a shell prints only where the part stands nowhere above its top (the "
+    "built-in engine prints this one)";
+inline constexpr std::string_view kOneRunShellWhole =
+    "in one slicer run a shell prints only where the part stands nowhere above its top "
+    "('nonplanar slice' prints this one)";
+
 struct EngineShell {
   std::string gcode;                   ///< the whole program, without our header
   std::vector<LayerToolpaths> layers;  ///< core bottom to top, then the shell, for the gate

@@ -228,7 +228,8 @@ double ShellPlan::thickness(int j, double x, double y) const {
 }
 
 ShellPlan plan_shell(const TriangleMesh& mesh, const Analysis& a, const std::vector<int>& patches,
-                     const LayerParams& p, double frame, bool even_core, const Context* cancel) {
+                     const LayerParams& p, double frame, bool even_core, const Context* cancel,
+                     std::string_view whole_only) {
   ShellPlan s;
   auto cancelled = [&] {
     if (!cancel || !cancel->cancelled()) return false;
@@ -298,6 +299,10 @@ ShellPlan plan_shell(const TriangleMesh& mesh, const Analysis& a, const std::vec
     return s;
   }
   take_region(s, std::move(region));
+  if (!whole_only.empty() && !s.region.empty()) {
+    s.refused = whole_only;
+    return s;
+  }
   if (const std::string why = rest_on_core(mesh, in_patch, p, 1.5 * h_c - s.reach + 0.05, s);
       !why.empty()) {
     s.refused = why;
@@ -353,8 +358,8 @@ ShellPlan choose_first(const TriangleMesh& mesh, const Analysis& a, const LayerP
   const bool group = near.size() > 1 && near.size() < all.size();
   ShellPlan plan, some;
   core::parallel_for(0, group ? 2 : 1, [&](int k) {
-    if (k == 0) plan = plan_shell(mesh, a, all, p, 0, c.even_core, c.cancel);
-    if (k == 1) some = plan_shell(mesh, a, near, p, 0, c.even_core, c.cancel);
+    if (k == 0) plan = plan_shell(mesh, a, all, p, 0, c.even_core, c.cancel, c.whole_only);
+    if (k == 1) some = plan_shell(mesh, a, near, p, 0, c.even_core, c.cancel, c.whole_only);
   });
   // The ankle base's rim prints as a shell, its ledge planar: say why not both.
   auto narrowed = [&](ShellPlan s, const std::vector<int>& wider, const std::string& why) {
@@ -368,7 +373,7 @@ ShellPlan choose_first(const TriangleMesh& mesh, const Analysis& a, const LayerP
   if (!plan.refused.empty() && group && some.refused.empty())
     return narrowed(std::move(some), all, plan.refused);
   if (!plan.refused.empty() && all.size() > 1) {
-    ShellPlan one = plan_shell(mesh, a, {all.front()}, p, 0, c.even_core, c.cancel);
+    ShellPlan one = plan_shell(mesh, a, {all.front()}, p, 0, c.even_core, c.cancel, c.whole_only);
     if (one.refused.empty())
       return narrowed(std::move(one), group ? near : all, group ? some.refused : plan.refused);
   }
@@ -377,8 +382,11 @@ ShellPlan choose_first(const TriangleMesh& mesh, const Analysis& a, const LayerP
 
 }  // namespace
 
-ShellPlan choose_shell(const TriangleMesh& mesh, const Analysis& a, const LayerParams& p) {
-  return choose_first(mesh, a, p, {});
+ShellPlan choose_shell(const TriangleMesh& mesh, const Analysis& a, const LayerParams& p,
+                       std::string_view whole_only) {
+  ShellChoice c;
+  c.whole_only = whole_only;
+  return choose_first(mesh, a, p, c);
 }
 
 std::vector<ShellPlan> choose_shells(const TriangleMesh& mesh, const Analysis& a,

@@ -84,15 +84,21 @@ struct ShellPlan {
 /// the core's boundaries are planar layers PlanarLayers{z_1, h_c} that stacks can share.
 /// `cancel` (if given): once set, the plan stops between its steps, refused "cancelled" (each
 /// step takes up to a second or two on a large part under a sanitizer).
+/// `whole_only` (if not empty): a shell the part stands above somewhere (R not everywhere) is
+/// refused, with this reason, as soon as R is known (one slicer run prints a shell over the
+/// whole top or not at all; the rest of the plan would be made for nothing).
 ShellPlan plan_shell(const TriangleMesh& mesh, const Analysis& a, const std::vector<int>& patches,
                      const LayerParams& p, double frame = 0, bool even_core = false,
-                     const Context* cancel = nullptr);
+                     const Context* cancel = nullptr, std::string_view whole_only = {});
 
 /// The shell `slice` tries when no stack can be built, or when the stacks cover less than half
 /// the largest curved patch: all the patches that need curved layers as one top, or failing
 /// that the group of patches near the largest (as in choose_shells), or the largest alone (refused,
 /// with the first reason, when neither fits; patches empty when none needs curved layers).
-ShellPlan choose_shell(const TriangleMesh& mesh, const Analysis& a, const LayerParams& p);
+/// `whole_only`: as plan_shell's (a shell the part stands above is refused, and the next
+/// tried).
+ShellPlan choose_shell(const TriangleMesh& mesh, const Analysis& a, const LayerParams& p,
+                       std::string_view whole_only = {});
 
 /// The shells `slice` prints together: choose_shell's first; then, when the part stands above
 /// that one somewhere (its R not everywhere), one per further group of curved patches near
@@ -113,6 +119,9 @@ struct ShellChoice {
   std::vector<int> among;  ///< the patches to follow (empty: every one that needs curved layers)
   bool even_core = false;  ///< plan_shell's: a core whose layers stacks can share
   const Context* cancel = nullptr;  ///< plan_shell's: stop when this is cancelled
+  /// plan_shell's: not empty when one slicer run prints the shell (another slicer, prepare),
+  /// which then refuses one the part stands above, with this reason.
+  std::string whole_only;
 };
 /// choose_shells over `c.among` only (the patches no stack serves, beside the stacks).
 std::vector<ShellPlan> choose_shells(const TriangleMesh& mesh, const Analysis& a,

@@ -45,7 +45,7 @@ Expected<PreparedPart> prepare_shell(const TriangleMesh& placed, const SliceJob&
   auto a = analyze(placed, job.analysis, ctx);
   if (!a) return a.error();
   // slice_model printed choose_shells' first, which is choose_shell's (one_run_shells).
-  const layers::ShellPlan plan = layers::choose_shell(placed, *a, job.layers);
+  const layers::ShellPlan plan = layers::choose_shell(placed, *a, job.layers, kOneRunShellWhole);
   if (!plan.refused.empty() || !plan.region.empty() || plan.core.size() < 2)
     return Error{Status::internal_error, "prepare: the shell planned is not the one sliced"};
   const double z_s = plan.core.back();

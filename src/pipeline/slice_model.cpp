@@ -14,6 +14,7 @@
 #include "core/column_caster.hpp"
 #include "core/sanitizers.hpp"
 #include "engine/engine_route.hpp"
+#include "engine/shell_engine.hpp"
 #include "layers/banded_field.hpp"
 #include "nonplanar/deform.hpp"
 #include "nonplanar/gcode.hpp"
@@ -192,12 +193,22 @@ std::vector<int> shell_patches(const std::vector<layers::ShellPlan>& shells) {
 
 // layers::choose_shells, one shell only through an external engine (its one run takes one)
 // or for one slicer run (prepare); stopped when ctx is cancelled.
-std::vector<layers::ShellPlan> shells_for(const TriangleMesh& mesh, const Analysis& a,
-                                          const SliceJob& job, const Context& ctx) {
+layers::ShellChoice shell_choice(const SliceJob& job, const Context& ctx) {
   layers::ShellChoice c;
   c.most = job.engine.engine == Engine::builtin && !job.one_run_shells ? 4 : 1;
   c.cancel = &ctx;
-  return layers::choose_shells(mesh, a, job.layers, c);
+  // One run prints no shell the part stands above: such a plan is refused once its R is known
+  // (the bunny's was planned in full, 3 s beside PrusaSlicer's run and 143 MB, then refused),
+  // and the next one tried (the patches near the largest, the largest alone).
+  if (job.one_run_shells)
+    c.whole_only = kOneRunShellWhole;
+  else if (job.engine.engine != Engine::builtin)
+    c.whole_only = kEngineShellWhole;
+  return c;
+}
+std::vector<layers::ShellPlan> shells_for(const TriangleMesh& mesh, const Analysis& a,
+                                          const SliceJob& job, const Context& ctx) {
+  return layers::choose_shells(mesh, a, job.layers, shell_choice(job, ctx));
 }
 
 // The header lines and notices of the shells printed (r's), from the planar attempt's.
@@ -268,9 +279,7 @@ Expected<std::optional<SliceResult>> try_shell(const TriangleMesh& mesh, const S
   // The slicer prints the core's layers, then the shell's above them: it cannot go back to
   // the core after the shell, as printing beside what stands above the top needs.
   if (job.one_run_shells && !plan.region.empty()) {
-    planar.notices.push_back(
-        refused("in one slicer run a shell prints only where the part stands nowhere above its top "
-                "('nonplanar slice' prints this one)"));
+    planar.notices.push_back(refused(std::string(kOneRunShellWhole)));
     return std::optional<SliceResult>{};
   }
   SliceResult r;
@@ -514,7 +523,14 @@ Expected<std::optional<SliceResult>> shell_before_stacks(
                                                 : shells_for(mesh, pre.analysis, job, ctx);
   if (ctx.cancelled()) return Error{Status::cancelled, "cancelled"};
   const double area = area_of(pre.analysis, stacked_patches(stacked.plan));
-  if (shells.front().refused.empty() && area_of(pre.analysis, shell_patches(shells)) > 2 * area) {
+  const bool larger = area_of(pre.analysis, shell_patches(shells)) > 2 * area;
+  // One run's refusal (shells_for) is said, as when the shell was planned whole and then refused.
+  if (const layers::ShellPlan& first = shells.front();
+      larger && !first.refused.empty() && first.refused == shell_choice(job, ctx).whole_only)
+    stacked.notices.push_back(
+        {Notice::Kind::shell_refused, -1,
+         patch_names(first.patches) + " not printed as a shell: " + first.refused});
+  if (shells.front().refused.empty() && larger) {
     // A shell that may print: the cores go to it (should it not, the stacks are sliced again).
     if (ahead && shells.front().region.empty()) ahead->drop();
     auto why = [&](double curved) {

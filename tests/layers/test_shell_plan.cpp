@@ -159,6 +159,30 @@ TEST(ShellPlan, BesideATowerPrintsWhereNothingStandsAboveWithALittleSlack) {
   EXPECT_NEAR(s.slot_level(35, 11.8, u), u, 0.1);
 }
 
+// One slicer run prints a shell over the whole top or none (whole_only): the rib with the tower
+// against it is refused with the reason given, as soon as R is known (no core planned); the
+// rib alone, which nothing stands above, plans as without it.
+TEST(ShellPlan, OneRunRefusesAShellThePartStandsAbove) {
+  TriangleMesh tower = test::rib();
+  test::append(tower, test::box({30, 12, 0}, {40, 16, 14}));
+  const Analysis a = *analyze(tower, {}, {});
+  const layers::ShellPlan s =
+      layers::plan_shell(tower, a, curved(a), {}, 0, false, nullptr, "one run");
+  EXPECT_EQ(s.refused, "one run");
+  EXPECT_FALSE(s.region.empty());
+  EXPECT_TRUE(s.core.empty());
+  EXPECT_EQ(layers::choose_shell(tower, a, {}, "one run").refused, "one run");
+  const TriangleMesh rib = test::rib();
+  const Analysis b = *analyze(rib, {}, {});
+  const layers::ShellPlan alone =
+      layers::plan_shell(rib, b, curved(b), {}, 0, false, nullptr, "one run");
+  const layers::ShellPlan any = layers::plan_shell(rib, b, curved(b), {});
+  ASSERT_TRUE(alone.refused.empty()) << alone.refused;
+  EXPECT_TRUE(alone.region.empty());
+  EXPECT_EQ(alone.core, any.core);
+  EXPECT_EQ(alone.N, any.N);
+}
+
 // A void whose ceiling is 0.3 mm under the four-layer shell's bottom at x = 20 (B = 6.55 mm,
 // ceiling 6.25 mm): the shell takes three layers, whose bottom (6.75 mm) leaves room for a core
 // layer between it and the ceiling (1.5 h_c − a + 0.05 = 0.23 mm at the defaults).
