@@ -373,6 +373,10 @@ ShellPlan choose_first(const TriangleMesh& mesh, const Analysis& a, const LayerP
   if (!plan.refused.empty() && group && some.refused.empty())
     return narrowed(std::move(some), all, plan.refused);
   if (!plan.refused.empty() && all.size() > 1) {
+    // The refused plans' rasters go before the next is made: the bunny's two (refused as one
+    // slicer run's) held beside the largest patch's plan peaked at 182-185 MB through
+    // PrusaSlicer, where the two planned in full had peaked at 143.
+    for (ShellPlan* r : {&plan, &some}) r->top = {}, r->region = {}, r->slack = {}, r->levels = {};
     ShellPlan one = plan_shell(mesh, a, {all.front()}, p, 0, c.even_core, c.cancel, c.whole_only);
     if (one.refused.empty())
       return narrowed(std::move(one), group ? near : all, group ? some.refused : plan.refused);
