@@ -93,8 +93,8 @@ class Reader {
   Reader(GcodeProgram& p, const Sink* sink, const LineSink* lines = nullptr)
       : p_(p), sink_(sink), line_sink_(lines) {}
   void run(std::string_view text);
-  /// Counts the lines and finds the print; nothing is read yet.
-  void begin(std::string_view text);
+  /// Counts the lines (unless given) and finds the print; nothing is read yet.
+  void begin(std::string_view text, std::optional<std::size_t> lines = std::nullopt);
   /// Reads on up to line `end` (0-based, not included).
   void read_to(std::size_t end);
   std::size_t lines() const { return n_; }
@@ -149,13 +149,13 @@ void Reader::run(std::string_view text) {
   // through PrusaSlicer. Room never written is never resident.
   if (!sink_ && !line_sink_)
     reserve_huge(p_.lines, n.lines), reserve_huge(p_.moves, n.g_lines + n.g_lines / 2 + 1024);
-  begin(text);
+  begin(text, n.lines);
   read_to(n_);
 }
 
-void Reader::begin(std::string_view text) {
+void Reader::begin(std::string_view text, std::optional<std::size_t> lines) {
   text_ = text;
-  n_ = count_gcode_lines(text).lines;
+  n_ = lines ? *lines : count_gcode_lines(text).lines;
   find_print(text);
 }
 
