@@ -171,8 +171,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   ForeignMapOptions one_layer;
   one_layer.layers_at_once = 1;
   const auto again = map_foreign_gcode(in, field, {}, {}, one_layer);
-  if (mapped.ok() != again.ok() || (mapped && mapped->text() != again->text()))
-    __builtin_trap();
+  if (mapped.ok() != again.ok() || (mapped && mapped->text() != again->text())) __builtin_trap();
   static const Waves clip;
   ForeignMapOptions o;
   o.clip = &clip;
