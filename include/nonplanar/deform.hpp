@@ -2,6 +2,7 @@
 // layers become planar, (x, y, z) ↦ (x, y, ζ(T(x, y, z))), subdividing where the map bends.
 #pragma once
 
+#include <functional>
 #include <limits>
 #include <optional>
 #include <string>
@@ -75,7 +76,9 @@ struct ForeignGcode {
   /// ;LAYER_CHANGE), the print (its layers, written from steps), the end (the end G-code, the
   /// E reset before it included). Two runs join by their blocks (the shell route).
   std::string start, print, end;
-  std::vector<LayerToolpaths> layers;  ///< one per ;LAYER_CHANGE of the print
+  std::vector<LayerToolpaths> layers;  ///< one per ;LAYER_CHANGE of the print, in print order
+  /// Per layer of `layers`: 1 where ForeignMapOptions::before_layer gave it (empty: none).
+  std::vector<char> inserted;
   /// The whole program: start, print and end as one text.
   std::string text() const { return start + print + end; }
   /// The same after `head`, taking the blocks' text (no copy of the print kept).
@@ -122,11 +125,26 @@ struct ForeignMapOptions {
   /// object on the plate than the one the field was planned for. Travels to them are still
   /// lifted over curved layers. Empty: every move is mapped.
   std::vector<char> planar_lines;
-  /// Without a clip, the file is read this many layers at a time (GcodePieceReader), their
-  /// moves mapped side by side, then written: only those layers' lines, moves and paths are
+  /// The file is read this many layers at a time (GcodePieceReader), their moves mapped side
+  /// by side (one by one, clipped), then written: only those layers' lines, moves and paths are
   /// held (the bunny through PrusaSlicer: 64 layers held up to 131 000 moves, 16 MB; 32 took
   /// its peak from 160-170 MB to 152-162 MB, map back 0.86-1.0 s either way).
   std::size_t layers_at_once = 32;
+  /// Paths printed between the file's layers, where they lie (mapped; each point's height the
+  /// thickness under it): a shell's pieces where the part stands above its top
+  /// (shell_pieces_with_engine, engine/shell_engine.hpp). Called before each layer of the print
+  /// with the file's ;Z: of it, and after the last with +inf, with where the nozzle is; returns
+  /// what to print there, in order, each piece a layer of the gate's (empty: nothing). They are
+  /// written as the built-in writer writes paths: a travel lifted over what is printed, retracted
+  /// by the file's first retraction on the way (its length owed to the file's next E after the
+  /// last, so its own retractions balance as written); the nozzle then waits lifted over them until
+  /// the file's next move in X or Y, which travels lifted. Null: nothing.
+  std::function<std::vector<LayerToolpaths>(double z, const Vec3& at)> before_layer;
+  /// Filament per mm of an inserted path of width w, height h (mm): filament_per_mm
+  /// (gcode.hpp) with the print's settings. Needed with before_layer.
+  std::function<double(double w, double h)> filament_per_mm;
+  /// The travels to inserted paths, mm/s (their speeds are the paths' own).
+  double inserted_travel_speed = 150;
 };
 
 /// Maps a planar G-code file (PrusaSlicer's or OrcaSlicer's, or ours) sliced from the

@@ -17,9 +17,6 @@
 
 namespace nonplanar {
 
-/// Filament length (mm) per mm of path for a bead of width w, height h (Slic3r's model).
-double filament_per_mm(double width, double height, const GcodeParams& g);
-
 /// Are the profile's start and end G-code safe for make_gcode? Refused: a placeholder or
 /// macro it cannot fill in ("{max_layer_z}", "[printer_model]", "{if …}"), outside comments;
 /// a move off the bed; a line over 255 characters, or with a control byte, or a non-ASCII

@@ -55,4 +55,8 @@ Expected<std::vector<LayerToolpaths>> make_toolpaths(const std::vector<SlicedLay
 /// rectangle with semicircular ends): w − h·(1 − π/4). A bead's cross-section is h·spacing.
 double bead_spacing(double width, double height);
 
+/// Filament length (mm) per mm of path for a bead of width w, height h (Slic3r's model: the
+/// bead's cross-section over the filament's, times the extrusion multiplier).
+double filament_per_mm(double width, double height, const GcodeParams& g);
+
 }  // namespace nonplanar

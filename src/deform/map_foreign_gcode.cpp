@@ -43,6 +43,9 @@ struct Writing {
   double pending = 0;           ///< filament owed from before the print, given back at the first E
   double retracted = 0;         ///< filament the print's own retractions leave pulled back
   program::PrintedTop printed;  ///< what the travels must clear (mapped extrusions so far)
+  /// After inserted paths (ForeignMapOptions::before_layer): the top of what they laid, which
+  /// the nozzle waits over until the file's next move in X or Y (NaN: not waiting).
+  double hover = std::numeric_limits<double>::quiet_NaN();
 };
 
 // An extrusion or wipe (a travel step, retracting as it goes), one G1 per mapped piece; an
@@ -54,6 +57,10 @@ void add_pieces(const GcodeMove& m, const ExtrusionPath& p, LayerToolpaths& L, l
   double l3 = 0;
   for (std::size_t q = 1; q < p.points.size(); ++q) l3 += (p.points[q] - p.points[q - 1]).norm();
   double f = m.f;
+  if (!std::isnan(s.hover)) {  // waiting over inserted paths: down to this one's start
+    s.layer.lifted_travel(s.at, p.points[0], s.at.z(), kNoValue, kNoValue);
+    s.at = p.points[0], s.hover = std::numeric_limits<double>::quiet_NaN();
+  }
   if (s.pending != 0 && m.has_e) {
     s.layer.start(ProgramStep::Kind::retract);
     s.layer.move_from(s.at, s.at, s.pending, kNoValue), s.pending = 0;
@@ -105,15 +112,19 @@ void add_travel(const GcodeMove& m, const LayerField& field, const MapBackParams
   }
   const Vec3 planar_to = m.has_xy ? m.to : Vec3(s.at.x(), s.at.y(), m.to.z());
   const Mapped target = keep ? Mapped{planar_to, m.height} : map_point(field, planar_to, m.height);
-  const Vec3 to = target.p;
+  Vec3 to = target.p;
   bool curved =
       target.p.z() != m.to.z() || !field.planar_at(m.from.x(), m.from.y()) ||
       !field.planar_along(m.from.head<2>(), m.to.head<2>(), field.t_of_zeta(m.to.z() - m.height),
                           field.t_of_zeta(m.to.z()));
+  const bool hovering = !std::isnan(s.hover);
+  if (hovering && !m.has_xy) to.z() = std::max(to.z(), s.at.z());  // a layer change: still over
+  if (hovering && m.has_xy) curved = true;
   // Over what was printed before along the way where it stands higher than this layer (a
   // planar object's layer after a curved layer of the planned part that rose above it: the
   // dome beside a cube was crossed at the cube's height + 0.3 mm, 0.4 mm under its top).
   double top = L.max_z;
+  if (hovering && m.has_xy) top = std::max(top, s.hover), s.hover = std::nan("");
   if (m.has_xy) {
     const double clear =
         s.printed.to_clear(s.at, to, params.tip_radius + program::kTravelCorridor, top);
@@ -131,6 +142,85 @@ void add_travel(const GcodeMove& m, const LayerField& field, const MapBackParams
     s.layer.move_from(s.at, to, de, m.f);
   }
   s.at = to;
+}
+
+// Paths printed between the file's layers (ForeignMapOptions::before_layer), as the built-in
+// writer prints its own: each piece a layer, each path travelled to lifted over what is
+// printed, pulled back by the
+// file's retraction on the way and given it back there, then extruded by the printer's
+// filament model at each point's height. After the last the filament stays pulled back (owed
+// to the file's next E, so that its own retractions balance as it wrote them) and the nozzle
+// waits lifted where it ended: the file's next layer change would lower it into them there.
+void write_inserted(std::vector<LayerToolpaths>& pieces, const GcodeRetraction& r,
+                    const MapBackParams& params, const ForeignMapOptions& o, Writing& s) {
+  const double travel_f = 60 * o.inserted_travel_speed;
+  const double pull_f = std::isnan(r.f) ? travel_f : r.f;
+  const double back_f = std::isnan(r.back_f) ? pull_f : r.back_f;
+  if (std::none_of(pieces.begin(), pieces.end(), [](const LayerToolpaths& L) {
+        return std::any_of(L.paths.begin(), L.paths.end(),
+                           [](const ExtrusionPath& p) { return p.points.size() >= 2; });
+      }))
+    return;
+  double back = s.retracted + s.pending;  // filament pulled back now, mm
+  auto pull_to = [&](double to) {
+    if (std::abs(to - back) < 1e-9) return;
+    s.layer.start(ProgramStep::Kind::retract);
+    s.layer.move_from(s.at, s.at, back - to, to > back ? pull_f : back_f);
+    back = to;
+  };
+  s.layer.clear();
+  s.layer.raw("; nonplanar: curved paths printed between the engine's layers");
+  double laid = std::isnan(s.hover) ? -std::numeric_limits<double>::infinity() : s.hover;
+  for (LayerToolpaths& L : pieces) {
+    // A layer of its own, as the built-in engine writes a piece: a viewer or a checker reads
+    // the layer's points together (a plane through them at a point, its highest layer there).
+    s.layer.raw(";LAYER_CHANGE");
+    s.layer.z_comment(L.z);
+    s.layer.height_comment(L.height);
+    ExtrusionRole role = ExtrusionRole::skirt;
+    double width = -1;
+    for (const ExtrusionPath& p : L.paths) {
+      if (p.points.size() < 2) continue;
+      const Vec3& to = p.points.front();
+      if ((to - s.at).head<2>().norm() > 1e-6 || std::abs(to.z() - s.at.z()) > 1e-6) {
+        pull_to(std::max(r.length, 0.0));
+        double top = std::max({L.max_z, laid, s.at.z(), to.z()});
+        top = s.printed.to_clear(s.at, to, params.tip_radius + program::kTravelCorridor, top);
+        const double lift = travel_height(s.at, to, top, std::max(L.max_slope, 1.0),
+                                          params.tip_radius, params.travel_lift);
+        if (std::isnan(lift)) {
+          s.layer.start(ProgramStep::Kind::travel);
+          s.layer.move_from(s.at, to, kNoValue, travel_f);
+        } else {
+          s.layer.lifted_travel(s.at, to, std::max(lift, s.at.z()), travel_f, travel_f);
+        }
+        s.at = to;
+      }
+      pull_to(0);
+      if (p.role != role) s.layer.line(";TYPE:%s", role_name(p.role));
+      if (std::abs(p.width - width) > 1e-9) s.layer.line(";WIDTH:%.3f", p.width);
+      role = p.role, width = p.width;
+      s.layer.start(ProgramStep::Kind::extrusion, p.role, p.width);
+      double f = 60 * p.speed;
+      for (std::size_t k = 1; k < p.points.size(); ++k) {
+        const Vec3& q = p.points[k];
+        const double de =
+            (q - s.at).norm() * o.filament_per_mm(p.width, 0.5 * (p.height[k] + p.height[k - 1]));
+        s.layer.move_from(s.at, q, de, f, p.height[k]);
+        f = kNoValue;
+        s.printed.lay(s.at, q);
+        laid = std::max(laid, q.z());
+        s.at = q;
+      }
+    }
+  }
+  pull_to(std::max(r.length, back));
+  const Vec3 over(s.at.x(), s.at.y(), std::max(s.at.z(), laid) + params.travel_lift);
+  s.layer.start(ProgramStep::Kind::travel);
+  s.layer.move_from(s.at, over, kNoValue, travel_f);
+  s.at = over, s.hover = laid;
+  s.pending = back - s.retracted;
+  program::write_program_layer(s.w, s.layer);
 }
 
 // One mapped layer as steps (s.layer); ;Z: becomes its highest point and ;HEIGHT: its mean
@@ -182,6 +272,15 @@ void build_layer(const LayerWork& work, const LayerField& field, const MapBackPa
   L.nonplanar = true;
 }
 
+// The file's first retraction in its print (none: length 0), read ahead up to it (its first
+// layer, as a rule), so that a clip in the print's first piece retracts as in its last.
+GcodeRetraction first_retraction(std::string_view text) {
+  GcodePieceReader ahead(text);
+  while (ahead.next(1) && !(ahead.program().retraction.length > 0)) {
+  }
+  return ahead.program().retraction;
+}
+
 // What the layers share while they are written in order.
 struct InOrder {
   GcodeProgram& prog;
@@ -192,8 +291,22 @@ struct InOrder {
   ForeignGcode& out;
   Writing& s;
   std::vector<char>& dropped;  ///< per layer: cut away whole
+  /// The file's first retraction in its print: what its cut-away travels and the inserted
+  /// paths' retract by.
+  GcodeRetraction retraction;
   std::size_t clip_samples = 0, points = 0;
+  /// Inserted paths (options.before_layer), each with the file's layer it went before.
+  std::vector<std::pair<std::size_t, LayerToolpaths>> inserted{};
 };
+
+// What options.before_layer gives before the file's layer `layer` at `z` (+inf: after the
+// last), written.
+void insert_before(InOrder& o, std::size_t layer, double z) {
+  if (!o.options.before_layer) return;
+  std::vector<LayerToolpaths> pieces = o.options.before_layer(z, o.s.at);
+  write_inserted(pieces, o.retraction, o.params, o.options, o.s);
+  for (LayerToolpaths& L : pieces) o.inserted.emplace_back(layer, std::move(L));
+}
 
 // One layer: cut back under the shell (options.clip), mapped (unless `premapped`, its point
 // count from map_gcode_layers, says it is), top skins ordered, built as steps and written.
@@ -225,7 +338,7 @@ std::optional<Error> write_layer(InOrder& o, const GcodeLayerSpan& span,
     auto bound = [&](const Vec2& lo, const Vec2& hi) {
       return o.options.clip->slope_bound(lo, hi, z);
     };
-    if (const int bad = program::clip_layer(work, margin, bound, o.prog.retraction, o.params.passes,
+    if (const int bad = program::clip_layer(work, margin, bound, o.retraction, o.params.passes,
                                             o.clip_samples, untouched))
       return Error{Status::invalid_argument, "line " + std::to_string(bad) + ": more than " +
                                                  std::to_string(o.params.passes.most_clip_samples) +
@@ -250,7 +363,7 @@ std::optional<Error> write_layer(InOrder& o, const GcodeLayerSpan& span,
   return std::nullopt;
 }
 
-// The layers of one piece of the print (all of it when clipped), mapped and written in order.
+// The layers of one piece of the print, mapped and written in order.
 std::optional<Error> write_piece(InOrder& o, const Context& ctx) {
   GcodeProgram& prog = o.prog;
   const std::vector<GcodeLine>& lines = prog.lines;
@@ -270,6 +383,7 @@ std::optional<Error> write_piece(InOrder& o, const Context& ctx) {
     std::string& text = o.s.w.out;
     if (text.capacity() - text.size() < (std::size_t{1} << 20))
       reserve_text(text, 2 * text.capacity());
+    insert_before(o, spans[k].layer, o.prog.layer_z[spans[k].layer]);
     if (auto e = write_layer(o, spans[k],
                              premapped.empty() ? std::nullopt : std::optional(premapped[k])))
       return e;
@@ -299,9 +413,9 @@ Expected<ForeignGcode> map_foreign_gcode(std::string_view text, const LayerField
                                          const MapBackParams& params, const Context& ctx,
                                          const ForeignMapOptions& options) {
   if (!(params.tolerance > 0)) return Error{Status::invalid_argument, "map tolerance: must be > 0"};
-  // Read a piece at a time: the start, a window of layers (all of them when clipped: a clip
-  // needs the file's retraction), the end. Held whole, the bunny's lines and moves through
-  // PrusaSlicer were 118 MB of the engine route's peak.
+  // Read a piece at a time: the start, a window of layers, the end. Held whole, the bunny's
+  // lines and moves through PrusaSlicer were 118 MB of the engine route's peak (and through a
+  // clip round its four shells, 365 MB against PrusaSlicer's 172).
   GcodePieceReader reader(text);
   GcodeProgram& prog = reader.program();
   if (reader.layer_count() == 0)
@@ -319,9 +433,8 @@ Expected<ForeignGcode> map_foreign_gcode(std::string_view text, const LayerField
   s.pending = options.start_retracted;
   std::vector<char> dropped;
   program::MovePaths mapped(0);
-  InOrder o{prog, mapped, field, params, options, out, s, dropped};
-  const std::size_t window =
-      options.clip ? reader.layer_count() : std::max<std::size_t>(1, options.layers_at_once);
+  InOrder o{prog, mapped, field, params, options, out, s, dropped, first_retraction(text)};
+  const std::size_t window = std::max<std::size_t>(1, options.layers_at_once);
   bool placed = false, first = true;
   while (reader.next(window) && reader.piece() == GcodePieceReader::Piece::layers) {
     if (auto e = first_unmappable(prog)) return *e;
@@ -345,6 +458,7 @@ Expected<ForeignGcode> map_foreign_gcode(std::string_view text, const LayerField
     if (auto e = write_piece(o, ctx)) return *e;
   }
   if (ctx.cancelled()) return Error{Status::cancelled, "cancelled"};
+  insert_before(o, out.layers.size(), std::numeric_limits<double>::infinity());
   out.print = std::move(s.w.out);
   s.w.out.clear();
   out.end_at = s.at, out.retracted = s.retracted, out.relative_e_at_end = prog.at_end.relative_e;
@@ -354,8 +468,22 @@ Expected<ForeignGcode> map_foreign_gcode(std::string_view text, const LayerField
   for (const GcodeLine& l : prog.lines) s.w.raw(l.raw);
   if (s.w.fault) return *s.w.fault;
   out.end = std::move(s.w.out);
-  for (std::size_t k = dropped.size(); k-- > 0;)
-    if (dropped[k]) out.layers.erase(out.layers.begin() + static_cast<long>(k));
+  // The gate's layers in print order: those cut away whole left out, the inserted ones where
+  // they were written.
+  std::vector<LayerToolpaths> layers;
+  layers.reserve(out.layers.size() + o.inserted.size());
+  auto ins = o.inserted.begin();
+  for (std::size_t k = 0; k <= out.layers.size(); ++k) {
+    for (; ins != o.inserted.end() && ins->first == k; ++ins) {
+      if (out.inserted.empty()) out.inserted.assign(layers.size(), 0);
+      layers.push_back(std::move(ins->second)), out.inserted.push_back(1);
+    }
+    if (k < out.layers.size() && !dropped[k]) {
+      layers.push_back(std::move(out.layers[k]));
+      if (!out.inserted.empty()) out.inserted.push_back(0);
+    }
+  }
+  out.layers = std::move(layers);
   return out;
 }
 

@@ -47,16 +47,17 @@ Expected<EngineOutput> slice_with(const TriangleMesh& to_slice, const LayerField
 /// split and stitched into one program (shell_with_engine: one shell only). Errors: unsupported
 /// (the engine's core is off the plan's boundaries), those of the stages and the engine, cancelled.
 /// `stacks`: curved stacks in the core (shell_toolpaths' CoreStacks field), built-in engine only
-/// (else unsupported).
-Expected<EngineOutput> shell_with(const TriangleMesh& mesh,
-                                  const std::vector<layers::ShellPlan>& plans,
+/// (else unsupported). Through an engine, a plan's `slack` may be spent (freed) once its
+/// shell's pieces are cut (shell_pieces_with_engine).
+Expected<EngineOutput> shell_with(const TriangleMesh& mesh, std::vector<layers::ShellPlan>& plans,
                                   const EngineRoute& route, const Context& ctx,
                                   const LayerField* stacks = nullptr);
 
 /// Our header over an external engine's file: the route, `header` (what was curved) and the
 /// settings forced on the engine's runs; shell_first_layer > 0: the shell route's, with its
-/// core's first layer height (mm). Lines end with '\n'.
+/// core's first layer height (mm), and shell_pieces when the shells went between the core's
+/// layers (engine_shell_settings). Lines end with '\n'.
 std::string engine_header(const EngineRoute& route, const std::vector<std::string>& header,
-                          double shell_first_layer);
+                          double shell_first_layer, bool shell_pieces = false);
 
 }  // namespace nonplanar

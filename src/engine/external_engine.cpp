@@ -113,7 +113,14 @@ std::vector<std::string> engine_forced_settings(const EngineParams& e, const Pri
   return s;
 }
 
-std::vector<std::string> engine_shell_settings(double first_layer) {
+std::vector<std::string> engine_shell_settings(double first_layer, bool pieces) {
+  if (pieces)
+    return {
+        "core: one run of the part, its layer boundaries from a 3MF layer-height profile "
+        "(where flat floors land), first_layer_height = " +
+            num(first_layer),
+        "shells: the built-in engine's curved layers, in pieces between the core's layers "
+        "(where the part stands above them)"};
   return {
       "core and shell: one run, its layer boundaries from a 3MF layer-height profile (the "
       "core's, where flat floors land, then the shell's above them), first_layer_height = " +

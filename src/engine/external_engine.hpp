@@ -38,8 +38,9 @@ struct EngineRun {
 std::string layer_height_profile(const std::vector<double>& tops, double h, double top);
 
 /// What the shell route asks of its run (header lines); first_layer: the core's first layer
-/// height, mm.
-std::vector<std::string> engine_shell_settings(double first_layer);
+/// height, mm; pieces: the shells' pieces go between the core's layers
+/// (shell_pieces_with_engine), not in the same run.
+std::vector<std::string> engine_shell_settings(double first_layer, bool pieces = false);
 
 /// A PrusaSlicer run started before its mesh exists: it loads its libraries and the profile
 /// (0.13 s of its 0.38 s on the sine roof) while the pipeline plans the layers, then reads the

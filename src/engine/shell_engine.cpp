@@ -2,56 +2,102 @@
 // a the reach; the core's layer with top z is printed where z <= B + a.
 #include "engine/shell_engine.hpp"
 
+#include <malloc.h>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
 #include <map>
 #include <optional>
+#include <span>
 
+#include "core/ahead_run.hpp"
+#include "core/sanitizers.hpp"
 #include "engine/external_engine.hpp"
 #include "engine/shell_split.hpp"
+#include "engine/shell_toolpaths.hpp"
+#include "layers/height_contour.hpp"
 #include "nonplanar/deform.hpp"
 
 namespace nonplanar {
 namespace {
 
-// The core's layers cut back under the shell: kept where H − N·t + a − z >= 0 within `inset`
-// all round. The built-in core draws its perimeters inside the kept region, so its beads end
-// half a width short of the cut; cut lines of the engine's paths end on it. With the bead on
-// the cut, the shell's lowest layer a tip's radius downhill is r·tan θ lower, and on the
-// wing's 27° side that entered the core by 0.12 mm, over the collision test's h / 2.
+// The core's layers cut back under the shells: kept where H − N·t + a − z >= 0 within `inset`
+// all round, or (a shell the part stands above somewhere) outside its region R. The built-in
+// core draws its perimeters inside the kept region, so its beads end half a width short of the
+// cut; cut lines of the engine's paths end on it. With the bead on the cut, the shell's lowest
+// layer a tip's radius downhill is r·tan θ lower, and on the wing's 27° side that entered the
+// core by 0.12 mm, over the collision test's h / 2.
 class CoreClip final : public LayerClip {
  public:
-  CoreClip(const layers::ShellPlan& p, double inset) : p_(p), inset_(inset), slopes_(p.top) {
-    const auto [lo, hi] = std::minmax_element(p.top.h.begin(), p.top.h.end());
-    lo_ = *lo, hi_ = *hi;
+  CoreClip(std::span<const layers::ShellPlan> plans, double inset) : inset_(inset) {
+    for (const layers::ShellPlan& p : plans) {
+      const auto [lo, hi] = std::minmax_element(p.top.h.begin(), p.top.h.end());
+      shells_.push_back({&p, layers::TopSlopeBound(p.top),
+                         p.region.empty() ? layers::NodeDistance{} : signed_distance(p.region), *lo,
+                         *hi});
+    }
     for (int k = 0; k < 8; ++k) {
       const double a = k * M_PI / 4;
       around_[static_cast<std::size_t>(k)] = Vec2(inset_ * std::cos(a), inset_ * std::sin(a));
     }
   }
   Cover cover(double z) const override {
-    const double level = p_.core_level(z);
-    return level <= lo_ ? Cover::all : level > hi_ ? Cover::none : Cover::some;
+    bool all = true, none = true;
+    for (const Shell& s : shells_) {
+      const double level = s.plan->core_level(z);
+      all = all && level <= s.lo;
+      none = none && level > s.hi && s.plan->region.empty();
+    }
+    return all ? Cover::all : none ? Cover::none : Cover::some;
   }
-  // The least over the point and 8 around it at the inset: continuous, as the clip needs.
+  // The least over the shells that cut the layer of: the least of H − level over the point
+  // and 8 around it at the inset, and with a region the larger of that and cell·D (D R's
+  // signed distance, > 0 outside): continuous, as the clip needs, and < 0 just where the
+  // built-in core is cut. Outside R, or above H's highest point, cell·D alone says the same,
+  // and its size is how far R is: a move away from it is looked at once.
   double margin(double x, double y, double z) const override {
-    double h = p_.top.height(x, y);
-    for (const Vec2& o : around_) h = std::min(h, p_.top.height(x + o.x(), y + o.y()));
-    return h - p_.core_level(z);
+    double m = std::numeric_limits<double>::infinity();
+    for (const Shell& s : shells_) {
+      const layers::ShellPlan& p = *s.plan;
+      const double level = p.core_level(z);
+      if (level <= s.lo) continue;  // H >= level: nothing cut
+      const double d = s.distance.empty() ? 0.0 : s.distance.cell * s.distance.value(x, y);
+      if (!s.distance.empty() && (d >= 0 || level > s.hi)) {
+        m = std::min(m, d);
+        continue;
+      }
+      double h = p.top.height(x, y);
+      for (const Vec2& o : around_) h = std::min(h, p.top.height(x + o.x(), y + o.y()));
+      m = std::min(m, s.distance.empty() ? h - level : std::max(h - level, d));
+    }
+    return std::isinf(m) ? 1e3 : m;
   }
-  // The least of H at 9 points is no steeper than H over the box they sweep.
-  double slope_bound(const Vec2& lo, const Vec2& hi, double) const override {
-    return slopes_.over(lo - Vec2::Constant(inset_), hi + Vec2::Constant(inset_));
+  // The least of H at 9 points is no steeper than H over the box they sweep; cell·D no
+  // steeper than √2.
+  double slope_bound(const Vec2& lo, const Vec2& hi, double z) const override {
+    double b = 0;
+    for (const Shell& s : shells_) {
+      const double level = s.plan->core_level(z);
+      if (level <= s.lo) continue;
+      if (s.distance.empty() || level <= s.hi)
+        b = std::max(b, s.slopes.over(lo - Vec2::Constant(inset_), hi + Vec2::Constant(inset_)));
+      if (!s.distance.empty()) b = std::max(b, std::sqrt(2.0));
+    }
+    return b;
   }
 
  private:
-  const layers::ShellPlan& p_;
+  struct Shell {
+    const layers::ShellPlan* plan;
+    layers::TopSlopeBound slopes;
+    layers::NodeDistance distance;  ///< R's, with a region
+    double lo, hi;                  ///< H's range
+  };
+  std::vector<Shell> shells_;
   double inset_ = 0;
-  layers::TopSlopeBound slopes_;
   std::array<Vec2, 8> around_;  ///< the 8 points at the inset, from the centre
-  double lo_ = 0, hi_ = 0;
 };
 
 }  // namespace
@@ -132,13 +178,17 @@ std::optional<Error> core_off_plan(const GcodeProgram& prog, const layers::Shell
 
 }  // namespace
 
-Expected<ForeignGcode> map_shell_core(std::string_view core_text, const layers::ShellPlan& plan,
-                                      const EngineRoute& job, const Context& ctx,
-                                      std::vector<char> others) {
-  const CoreClip clip(plan, 0.5 * job.print.paths.perimeter_width);
-  ForeignMapOptions core_opt;
+namespace {
+
+// The core's G-code mapped and cut back under the shells (one core: plans[0]'s boundaries),
+// with what `opt` says besides.
+Expected<ForeignGcode> map_core(std::string_view core_text,
+                                std::span<const layers::ShellPlan> plans, const EngineRoute& job,
+                                const Context& ctx, ForeignMapOptions opt) {
+  const layers::ShellPlan& plan = plans.front();
+  const CoreClip clip(plans, 0.5 * job.print.paths.perimeter_width);
+  ForeignMapOptions& core_opt = opt;
   core_opt.clip = &clip;
-  core_opt.planar_lines = std::move(others);
   const auto planar = planar_field(job.layers);
   auto core = map_foreign_gcode(core_text, *planar, job.map_back, ctx, core_opt);
   if (!core) {
@@ -150,13 +200,25 @@ Expected<ForeignGcode> map_shell_core(std::string_view core_text, const layers::
   // shell's lowest layer thicker or thinner than the gate believes: refuse such a core. A
   // layer of supports alone (PrusaSlicer prints them on layers of their own, a contact
   // distance under the part) holds no stair.
-  for (const LayerToolpaths& L : core->layers) {
+  for (std::size_t k = 0; k < core->layers.size(); ++k) {
+    const LayerToolpaths& L = core->layers[k];
+    if (!core->inserted.empty() && core->inserted[k]) continue;  // a shell's piece
     const bool part = std::any_of(L.paths.begin(), L.paths.end(), [](const ExtrusionPath& p) {
       return p.role != ExtrusionRole::support && p.role != ExtrusionRole::skirt && p.object == 0;
     });
     if (part && !on_boundary(plan, L.max_z)) return off_plan(L.max_z);
   }
   return core;
+}
+
+}  // namespace
+
+Expected<ForeignGcode> map_shell_core(std::string_view core_text, const layers::ShellPlan& plan,
+                                      const EngineRoute& job, const Context& ctx,
+                                      std::vector<char> others) {
+  ForeignMapOptions opt;
+  opt.planar_lines = std::move(others);
+  return map_core(core_text, std::span(&plan, 1), job, ctx, std::move(opt));
 }
 
 namespace {
@@ -202,8 +264,11 @@ Expected<ShellStack> shell_stack(const TriangleMesh& placed, const layers::Shell
 
 Expected<EngineShell> shell_with_engine(const TriangleMesh& mesh, const layers::ShellPlan& plan,
                                         const EngineRoute& job, const Context& ctx) {
-  // One engine run cannot stop its core part-way for the shell and go on after it.
-  if (!plan.region.empty()) return Error{Status::unsupported, std::string(kEngineShellWhole)};
+  // One engine run cannot stop its core part-way for the shell and go on after it: such a
+  // shell's pieces go between the layers of a run of the part alone.
+  if (!plan.region.empty())
+    return Error{Status::internal_error,
+                 "shell_with_engine: a shell the part stands above prints in pieces"};
   // One run of the part with the shell's slab above its core, split where the core ends, as
   // post-process splits the slicer's file of a prepared shell. Two runs side by side (the
   // core, and the slab alone) took the whole process 1.36 s of CPU on the wing, this one 1.08.
@@ -236,6 +301,62 @@ Expected<EngineShell> shell_with_engine(const TriangleMesh& mesh, const layers::
   ctx.progress("core", 1.0);
   return join_shell(std::move(*core), split->shell, plan, stack->base, job,
                     "the shell's curved layers, from the engine's layers above the core", ctx);
+}
+
+Expected<EngineShell> shell_pieces_with_engine(const TriangleMesh& mesh,
+                                               std::vector<layers::ShellPlan>& plans,
+                                               const EngineRoute& job, const Context& ctx) {
+  const std::vector<double> tops(plans.front().core.begin() + 1, plans.front().core.end());
+  // The shells' curved layers, cut into their slots, beside the engine's run of the core.
+  using Slots = std::vector<std::vector<LayerToolpaths>>;
+  core::AheadRun<Expected<Slots>> ahead(ctx, [&](const Context& c) -> Expected<Slots> {
+    std::vector<std::vector<LayerToolpaths>> shells;
+    for (const layers::ShellPlan& plan : plans) {
+      const std::vector<ExPolygon> R = layers::region_at_least(plan.region.as_top(), 0);
+      auto paths = shell_curved_layers(mesh, plan, R, job.print, c);
+      if (!paths) return paths.error();
+      shells.push_back(std::move(*paths));
+    }
+    return shell_slots(shells, plans, tops);
+  });
+  ctx.progress("engine", 0);
+  EngineRun run;
+  run.layer_tops = tops;
+  auto text = run_engine(job.engine, mesh, job.print, ctx, run, job.early);
+  if (!text) return text.error();
+  auto slots = ahead.get();
+  if (!slots) return slots.error();
+  for (layers::ShellPlan& plan : plans) plan.slack = {};  // (the slots are cut)
+#if defined(__GLIBC__) && !defined(NONPLANAR_SHADOW_MEMORY)
+  // The shells were sliced on a thread whose allocator arena keeps what they freed (their
+  // normalised meshes, sections): handed back before the core is mapped.
+  malloc_trim(0);
+#endif
+  ctx.progress("core", 0);
+  // Slot k follows the core's layer k − 1: its pieces go before the engine's first layer above
+  // that layer's top (a layer of supports alone in between, or the next core layer).
+  ForeignMapOptions opt;
+  std::size_t next = 1;
+  opt.before_layer = [&](double z, const Vec3& nozzle) {
+    std::vector<LayerToolpaths> out;
+    Vec2 at = nozzle.head<2>();
+    for (; next < slots->size() && z > tops[next - 1] + kSameZ; ++next)
+      for (LayerToolpaths& part : (*slots)[next]) {
+        order_piece(part, job.print.toolhead, at);
+        out.push_back(std::move(part));
+      }
+    return out;
+  };
+  opt.filament_per_mm = [&](double w, double h) { return filament_per_mm(w, h, job.print.gcode); };
+  opt.inserted_travel_speed = job.print.paths.travel_speed;
+  auto core = map_core(*text, plans, job, ctx, std::move(opt));
+  if (!core) return core.error();
+  std::string().swap(*text);
+  ctx.progress("core", 1.0);
+  EngineShell out;
+  out.layers = std::move(core->layers);
+  out.gcode = core->take_text();
+  return out;
 }
 
 namespace {

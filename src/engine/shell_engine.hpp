@@ -1,6 +1,7 @@
 // A shell over a planar core (layers/shell_plan.hpp) printed by an external engine
-// (PrusaSlicer): one run of the part with the shell's slab above it, split and stitched into
-// one program.
+// (PrusaSlicer): over the whole top, one run of the part with the shell's slab above it, split
+// and stitched into one program; where the part stands above the shells, one run of the part
+// alone, the shells' pieces written between its layers.
 #pragma once
 
 #include <string>
@@ -13,10 +14,8 @@
 namespace nonplanar {
 
 /// Why a shell the part stands above is not printed by one slicer run (it cannot stop its core
-/// part-way for the shell's pieces): through an engine (`slice --engine`), and for prepare.
-inline constexpr std::string_view kEngineShellWhole =
-    "through an engine, a shell prints only where the part stands nowhere above its top (the "
-    "built-in engine prints this one)";
+/// part-way for the shell's pieces): for prepare (`slice --engine` prints its pieces between
+/// the engine's core layers, shell_pieces_with_engine).
 inline constexpr std::string_view kOneRunShellWhole =
     "in one slicer run a shell prints only where the part stands nowhere above its top "
     "('nonplanar slice' prints this one)";
@@ -64,6 +63,20 @@ Expected<ShellStack> shell_stack(const TriangleMesh& placed, const layers::Shell
 /// those of the engine, the split and the mapping; cancelled.
 Expected<EngineShell> shell_with_engine(const TriangleMesh& mesh, const layers::ShellPlan& plan,
                                         const EngineRoute& job, const Context& ctx);
+
+/// Inputs: the placed mesh, accepted plans of shells the part stands above (each plan.region
+/// set; layers::choose_shells: one core), the route (its engine is PrusaSlicer). Output: one
+/// program: the engine's run of the part alone on the core's boundaries, mapped, each layer cut
+/// back inside each shell's R where z_k > B + a (as the built-in core), and between its layers
+/// the shells' pieces (shell_slots: the built-in engine's curved layers, each point after the
+/// core's layers up to its slot level; an engine run cannot stop its core part-way to print
+/// them), written into the program where they go (ForeignMapOptions::before_layer). The
+/// shells are sliced beside the engine's run. Errors: those of the engine and the mapping, and
+/// unsupported for a core off the planned boundaries; cancelled. Each plan's `slack` is spent
+/// (freed) once the pieces are cut: the bunny's four were 37 MB while its core was mapped.
+Expected<EngineShell> shell_pieces_with_engine(const TriangleMesh& mesh,
+                                               std::vector<layers::ShellPlan>& plans,
+                                               const EngineRoute& job, const Context& ctx);
 
 /// The core's G-code (a planar program sliced on plan.core's boundaries) mapped and cut back
 /// under the shell, as shell_with_engine maps its first run; the moves of `others` (0-based

@@ -160,64 +160,38 @@ std::vector<LayerToolpaths> interleave(std::vector<LayerToolpaths> core,
                                        const std::vector<layers::ShellPlan>& plans,
                                        const Toolhead& head) {
   const std::size_t K = core.size();
-  std::vector<std::vector<LayerToolpaths>> slots(K + 1);
-  for (std::size_t i = 0; i < shells.size(); ++i)
-    for (const LayerToolpaths& L : shells[i]) {
-      const layers::ShellPlan& plan = plans[i];
-      std::vector<LayerToolpaths*> in(K + 1, nullptr);
-      for (const ExtrusionPath& p : L.paths)
-        split_by_slot(p, plan, tops, [&](int k, ExtrusionPath&& piece) {
-          auto& s = slots[static_cast<std::size_t>(k)];
-          if (!in[static_cast<std::size_t>(k)]) {
-            LayerToolpaths part;  // L's figures, none of its paths yet
-            part.height = L.height, part.nonplanar = L.nonplanar, part.max_slope = L.max_slope;
-            part.max_z = -1e300;
-            s.push_back(std::move(part));
-            in[static_cast<std::size_t>(k)] = &s.back();
-          }
-          LayerToolpaths& part = *in[static_cast<std::size_t>(k)];
-          for (const Vec3& q : piece.points) part.max_z = std::max(part.max_z, q.z());
-          part.paths.push_back(std::move(piece));
-        });
-      // The pointers into `slots` stay valid: each slot gains one part per shell layer, and
-      // the next layer's parts are pushed only after this layer is done.
-    }
+  std::vector<std::vector<LayerToolpaths>> slots = shell_slots(shells, plans, tops);
   // A shell point printed before core layer k lies at most s⁻ (about 0.1 mm) over its top: a
   // core layer under the highest shell point so far travels over it lifted.
   std::vector<LayerToolpaths> out;
   double shell_so_far = -1e300;
   Vec2 at(0, 0);  // where the nozzle is, after the layers so far
-  auto last_point = [&](const LayerToolpaths& L) {
-    for (auto p = L.paths.rbegin(); p != L.paths.rend(); ++p)
-      if (!p->points.empty()) return at = p->points.back().head<2>(), void();
-  };
   for (std::size_t k = 0; k <= K; ++k) {
     for (LayerToolpaths& part : slots[k]) {
-      part.z = part.max_z;
       shell_so_far = std::max(shell_so_far, part.max_z);
-      std::vector<ExtrusionPath> ordered;
-      ordered.reserve(part.paths.size());
-      for (std::size_t i : program::order_reach_groups(part.paths, head, at))
-        ordered.push_back(std::move(part.paths[i]));
-      part.paths = std::move(ordered);
-      last_point(part);
+      order_piece(part, head, at);
       out.push_back(std::move(part));
     }
     if (k == K) break;
     LayerToolpaths& L = core[k];
-    last_point(L);
+    for (auto p = L.paths.rbegin(); p != L.paths.rend(); ++p)
+      if (!p->points.empty()) {
+        at = p->points.back().head<2>();
+        break;
+      }
     if (L.z < shell_so_far) L.nonplanar = true, L.max_z = std::max(L.max_z, shell_so_far);
     out.push_back(std::move(L));
   }
   return out;
 }
 
-// One shell's curved layers, bottom to top, mapped back; each point's height the thickness
-// under it. R: where it prints (empty: everywhere).
-Expected<std::vector<LayerToolpaths>> shell_layers(const TriangleMesh& mesh,
-                                                   const layers::ShellPlan& plan,
-                                                   const std::vector<ExPolygon>& R,
-                                                   const PrintConfig& print, const Context& ctx) {
+}  // namespace
+
+Expected<std::vector<LayerToolpaths>> shell_curved_layers(const TriangleMesh& mesh,
+                                                          const layers::ShellPlan& plan,
+                                                          const std::vector<ExPolygon>& R,
+                                                          const PrintConfig& print,
+                                                          const Context& ctx) {
   const bool partial = !plan.region.empty();
   // The shell: normalised so its layers are the planes ζ = j·t … (j + 1)·t.
   const layers::ShellField field(plan);
@@ -275,7 +249,48 @@ Expected<std::vector<LayerToolpaths>> shell_layers(const TriangleMesh& mesh,
   return paths;
 }
 
-}  // namespace
+std::vector<std::vector<LayerToolpaths>> shell_slots(
+    const std::vector<std::vector<LayerToolpaths>>& shells,
+    const std::vector<layers::ShellPlan>& plans, const std::vector<double>& tops) {
+  const std::size_t K = tops.size();
+  std::vector<std::vector<LayerToolpaths>> slots(K + 1);
+  for (std::size_t i = 0; i < shells.size(); ++i)
+    for (const LayerToolpaths& L : shells[i]) {
+      const layers::ShellPlan& plan = plans[i];
+      std::vector<LayerToolpaths*> in(K + 1, nullptr);
+      for (const ExtrusionPath& p : L.paths)
+        split_by_slot(p, plan, tops, [&](int k, ExtrusionPath&& piece) {
+          auto& s = slots[static_cast<std::size_t>(k)];
+          if (!in[static_cast<std::size_t>(k)]) {
+            LayerToolpaths part;  // L's figures, none of its paths yet
+            part.height = L.height, part.nonplanar = L.nonplanar, part.max_slope = L.max_slope;
+            part.max_z = -1e300;
+            s.push_back(std::move(part));
+            in[static_cast<std::size_t>(k)] = &s.back();
+          }
+          LayerToolpaths& part = *in[static_cast<std::size_t>(k)];
+          for (const Vec3& q : piece.points) part.max_z = std::max(part.max_z, q.z());
+          part.z = part.max_z;
+          part.paths.push_back(std::move(piece));
+        });
+      // The pointers into `slots` stay valid: each slot gains one part per shell layer, and
+      // the next layer's parts are pushed only after this layer is done.
+    }
+  return slots;
+}
+
+void order_piece(LayerToolpaths& part, const Toolhead& head, Vec2& at) {
+  std::vector<ExtrusionPath> ordered;
+  ordered.reserve(part.paths.size());
+  for (std::size_t i : program::order_reach_groups(part.paths, head, at))
+    ordered.push_back(std::move(part.paths[i]));
+  part.paths = std::move(ordered);
+  for (auto p = part.paths.rbegin(); p != part.paths.rend(); ++p)
+    if (!p->points.empty()) {
+      at = p->points.back().head<2>();
+      break;
+    }
+}
 
 Expected<std::vector<LayerToolpaths>> shell_toolpaths(const TriangleMesh& mesh,
                                                       const std::vector<layers::ShellPlan>& plans,
@@ -288,7 +303,7 @@ Expected<std::vector<LayerToolpaths>> shell_toolpaths(const TriangleMesh& mesh,
   for (const layers::ShellPlan& plan : plans) {
     R.push_back(plan.region.empty() ? std::vector<ExPolygon>{}
                                     : layers::region_at_least(plan.region.as_top(), 0));
-    auto paths = shell_layers(mesh, plan, R.back(), print, ctx);
+    auto paths = shell_curved_layers(mesh, plan, R.back(), print, ctx);
     if (!paths) return paths.error();
     shells.push_back(std::move(*paths));
   }

@@ -34,4 +34,28 @@ Expected<std::vector<LayerToolpaths>> shell_toolpaths(const TriangleMesh& mesh,
                                                       const PrintConfig& print, const Context& ctx,
                                                       const CoreStacks& stacks = {});
 
+/// One shell's curved layers, bottom to top, mapped back; each point's height the thickness
+/// under it (the lowest layer's down to the core's top, filling its stairs). Inputs: the placed
+/// mesh, an accepted plan, R: where it prints (layers::region_at_least of plan.region; empty:
+/// everywhere), the print settings. Errors: those of normalisation, slicing and mapping.
+Expected<std::vector<LayerToolpaths>> shell_curved_layers(const TriangleMesh& mesh,
+                                                          const layers::ShellPlan& plan,
+                                                          const std::vector<ExPolygon>& R,
+                                                          const PrintConfig& print,
+                                                          const Context& ctx);
+
+/// The shells' layers (shells[i] of plans[i], as shell_curved_layers gives them) cut into the
+/// pieces printed between the core's layers, whose tops are `tops` (mm, rising; K of them):
+/// slot k (0 … K) holds, layer by layer, the pieces printed after the core's first k layers
+/// (each point after the layers with tops up to its plan's slot_level); slot 0 is always
+/// empty. Each piece's z is its highest point; its paths in the shell layer's order.
+std::vector<std::vector<LayerToolpaths>> shell_slots(
+    const std::vector<std::vector<LayerToolpaths>>& shells,
+    const std::vector<layers::ShellPlan>& plans, const std::vector<double>& tops);
+
+/// A slot's piece, its paths put in the order the head reaches them from `at`
+/// (program::order_reach_groups: a band beside a wall is cut into pieces on all sides of it);
+/// `at` becomes where the piece ends.
+void order_piece(LayerToolpaths& part, const Toolhead& head, Vec2& at);
+
 }  // namespace nonplanar

@@ -21,12 +21,6 @@
 
 namespace nonplanar {
 
-double filament_per_mm(double width, double height, const GcodeParams& g) {
-  const double area = height * bead_spacing(width, height);  // rectangle with round ends
-  const double filament = M_PI * 0.25 * g.filament_diameter * g.filament_diameter;
-  return area / filament * g.extrusion_multiplier;
-}
-
 namespace {
 const char* flavor_name(GcodeFlavor f) {
   switch (f) {

@@ -86,6 +86,41 @@ FacetedTop NodeMask::as_top() const {
   return t;
 }
 
+NodeDistance signed_distance(const NodeMask& m) {
+  NodeDistance out;
+  out.origin = m.origin, out.cell = m.cell, out.nx = m.nx, out.ny = m.ny;
+  const std::size_t ny = static_cast<std::size_t>(m.ny), n = m.in.size();
+  constexpr int kFar = 32767;
+  // Two passes of the chessboard transform (each node from its 4 neighbours already passed),
+  // once to the nearest inside node and once to the nearest outside one.
+  auto transform = [&](signed char side) {
+    std::vector<int> d(n);
+    for (std::size_t k = 0; k < n; ++k) d[k] = m.in[k] == side ? 0 : kFar;
+    auto relax = [&](long i, long j, long di, long dj, int& v) {
+      const long a = i + di, b = j + dj;
+      if (a < 0 || b < 0 || a >= m.nx || b >= m.ny) return;
+      v = std::min(v, d[static_cast<std::size_t>(a) * ny + static_cast<std::size_t>(b)] + 1);
+    };
+    for (long i = 0; i < m.nx; ++i)
+      for (long j = 0; j < m.ny; ++j) {
+        int& v = d[static_cast<std::size_t>(i) * ny + static_cast<std::size_t>(j)];
+        relax(i, j, -1, -1, v), relax(i, j, -1, 0, v), relax(i, j, -1, 1, v), relax(i, j, 0, -1, v);
+      }
+    for (long i = m.nx - 1; i >= 0; --i)
+      for (long j = m.ny - 1; j >= 0; --j) {
+        int& v = d[static_cast<std::size_t>(i) * ny + static_cast<std::size_t>(j)];
+        relax(i, j, 1, 1, v), relax(i, j, 1, 0, v), relax(i, j, 1, -1, v), relax(i, j, 0, 1, v);
+      }
+    return d;
+  };
+  const std::vector<int> to_in = transform(1), to_out = transform(-1);
+  out.d.resize(n);
+  for (std::size_t k = 0; k < n; ++k)
+    out.d[k] = static_cast<std::int16_t>(std::min(kFar, m.in[k] > 0 ? to_out[k] : to_in[k]) *
+                                         (m.in[k] > 0 ? -1 : 1));
+  return out;
+}
+
 Vec2 FacetedTop::gradient(double x, double y) const {
   const auto [k, u, v] = raster_cell(origin, cell, nx, ny, x, y);
   const double* p = &h[k];

@@ -17,6 +17,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 #include "nonplanar/analysis.hpp"
@@ -73,6 +74,24 @@ struct NodeMask {
   /// The same values as heights (for a contour of them; 8 bytes a node while it lives).
   FacetedTop as_top() const;
 };
+
+/// A NodeMask's signed chessboard distance: at each node, how many cells (diagonal steps count
+/// 1) to the nearest node on the other side, + outside (−1 nodes), − inside; ±32767 where the
+/// other side has no node. A node next to the other side holds ±1, so in every cell with both
+/// sides the bilinear interpolant equals the mask's and elsewhere has its sign: the same zero
+/// set, and it changes by at most one cell a cell along each axis (|∇| <= √2 cells per cell).
+/// What a clip by the mask can step by: cell·value is at most √2 steep in mm per mm, and as far
+/// above 0 as the region is away (the core of a shell the part stands above, engine route).
+struct NodeDistance {
+  Vec2 origin{0, 0};  ///< node (0, 0), mm
+  double cell = 0.1;  ///< node spacing, mm
+  int nx = 0, ny = 0;
+  std::vector<std::int16_t> d;  ///< nx·ny, cells (node (i, j) at index i·ny + j)
+  bool empty() const { return d.empty(); }
+  /// The bilinear interpolant at (x, y), cells (constant past the raster's edge).
+  double value(double x, double y) const { return bilinear(d.data(), origin, cell, nx, ny, x, y); }
+};
+NodeDistance signed_distance(const NodeMask& m);
 
 /// Calls f(i, j, z) for every node (i, j) of t's raster (at t.origin + (i, j)·t.cell) inside
 /// triangle abc seen from above, z its plane's height there; a vertical triangle covers none.

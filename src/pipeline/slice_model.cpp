@@ -1,16 +1,12 @@
 // The pipeline (DESIGN.md §2): every stage is a free function; this only chains them and
 // checks the result against DESIGN.md §3 before anyone writes it.
-#include <malloc.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <functional>
 #include <optional>
-#include <thread>
 
-#include "core/ahead_run.hpp"
 #include "core/column_caster.hpp"
 #include "core/sanitizers.hpp"
 #include "engine/engine_route.hpp"
@@ -191,19 +187,17 @@ std::vector<int> shell_patches(const std::vector<layers::ShellPlan>& shells) {
   return all;
 }
 
-// layers::choose_shells, one shell only through an external engine (its one run takes one)
-// or for one slicer run (prepare); stopped when ctx is cancelled.
+// layers::choose_shells, one shell only for one slicer run (prepare); stopped when ctx is
+// cancelled. Through an engine, a shell the part stands above prints as the built-in's does,
+// its pieces between the engine's core layers (shell_pieces_with_engine).
 layers::ShellChoice shell_choice(const SliceJob& job, const Context& ctx) {
   layers::ShellChoice c;
-  c.most = job.engine.engine == Engine::builtin && !job.one_run_shells ? 4 : 1;
+  c.most = job.one_run_shells ? 1 : 4;
   c.cancel = &ctx;
   // One run prints no shell the part stands above: such a plan is refused once its R is known
   // (the bunny's was planned in full, 3 s beside PrusaSlicer's run and 143 MB, then refused),
   // and the next one tried (the patches near the largest, the largest alone).
-  if (job.one_run_shells)
-    c.whole_only = kOneRunShellWhole;
-  else if (job.engine.engine != Engine::builtin)
-    c.whole_only = kEngineShellWhole;
+  if (job.one_run_shells) c.whole_only = kOneRunShellWhole;
   return c;
 }
 std::vector<layers::ShellPlan> shells_for(const TriangleMesh& mesh, const Analysis& a,
@@ -260,7 +254,7 @@ void describe_shells(const std::vector<layers::ShellPlan>& shells, const std::st
 // `stacks`: curved stacks the core holds beside the shells (shells_beside_stacks), on the
 // core's layers.
 Expected<std::optional<SliceResult>> try_shell(const TriangleMesh& mesh, const SliceJob& job,
-                                               const std::vector<layers::ShellPlan>& shells,
+                                               std::vector<layers::ShellPlan>& shells,
                                                const std::string& why_shell, SliceResult& planar,
                                                const std::function<void()>& spent,
                                                EarlyEngine* early, const Context& ctx,
@@ -284,6 +278,7 @@ Expected<std::optional<SliceResult>> try_shell(const TriangleMesh& mesh, const S
   }
   SliceResult r;
   const EngineRoute route{job.engine, job.print, job.layers, job.map_back, early};
+  const bool pieces = !plan.region.empty();  // (shell_with may spend the rasters)
   auto printed = shell_with(mesh, shells, route, ctx, stacks ? stacks->field.get() : nullptr);
   if (!printed && printed.error().status == Status::unsupported) {
     planar.notices.push_back(refused(printed.error().message));
@@ -303,7 +298,7 @@ Expected<std::optional<SliceResult>> try_shell(const TriangleMesh& mesh, const S
     r.plan = *stacks;
     r.printed_curved += static_cast<int>(stacks->stacks.size());
   }
-  if (!r.gcode.empty()) r.gcode = engine_header(route, r.header, plan.core.at(1)) + r.gcode;
+  if (!r.gcode.empty()) r.gcode = engine_header(route, r.header, plan.core.at(1), pieces) + r.gcode;
   r.nonplanar = true;
   spent();
   std::string breach;
@@ -474,23 +469,6 @@ Notice dropped_notice(const SliceResult& r, int patch, const std::string& why,
   return n;
 }
 
-// shells_for while `engine` runs: at idle priority, so as not to slow the engine's run (the
-// plan is needed only once it is done; PrusaSlicer slices on both cores at first), unless the
-// run is done first (the machine busy with other work, or a short run): then planned again at
-// the caller's priority. Either plan is the same.
-std::vector<layers::ShellPlan> plan_beside(const TriangleMesh& mesh, const Analysis& a,
-                                           const SliceJob& job,
-                                           const core::AheadRun<Expected<SliceResult>>& engine,
-                                           const Context& ctx) {
-  core::AheadRun<std::vector<layers::ShellPlan>> idle(
-      ctx, [&](const Context& c) { return shells_for(mesh, a, job, c); }, core::Priority::idle);
-  while (!idle.ready() && !engine.ready() && !ctx.cancelled())
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
-  if (idle.ready()) return idle.get();
-  if (ctx.cancelled()) return {};        // (the caller returns at once)
-  return shells_for(mesh, a, job, ctx);  // (idle is stopped on the way out)
-}
-
 // A part whose stacks follow only a little of its curved top (the CurviSlicer car: 172 mm² of
 // roof, while its 486 mm² body, hollow under the hood, has none): a shell instead, if that
 // plans and passes the gate: over all its curved patches (the car: 1065 mm², 84 % of its
@@ -501,26 +479,17 @@ std::vector<layers::ShellPlan> plan_beside(const TriangleMesh& mesh, const Analy
 // attempt it deferred, its stacks planned but not sliced). Output: the shell's result when it
 // prints; else none, with the stacks' attempt sliced in `stacks` (their offenders in
 // `offenders`) and why the shell did not print in stacked.notices.
-// Through another slicer the stacks' run starts at once, beside the shell's planning, and is
-// stopped should the shell print: one run prints a shell only where the part stands nowhere
-// above it, so the bunny, Benchy, the ornament, the car and the spiky block all refuse theirs,
-// and the run is most of the time (the bunny's shell took 0.35 s to plan, PrusaSlicer 5.8 s
-// after it). The plan meanwhile takes only what the engine leaves of the cores: PrusaSlicer
-// slices on both at first, and the plan is needed only once its run is done.
+// Through another slicer the shell is planned first too: its pieces go between the engine's
+// core layers where the part stands above it, so the bunny, Benchy, the ornament, the car and
+// the spiky block print theirs (a run of the stacks started beside the plan, for a shell one
+// run would refuse, took both cores from it: the bunny's plan 6 s, not 1).
 Expected<std::optional<SliceResult>> shell_before_stacks(
     const TriangleMesh& mesh, const SliceJob& job, const Prepared& pre,
     const std::vector<int>& excluded, SliceResult& stacked,
     std::optional<Expected<SliceResult>>& stacks,
     std::vector<std::pair<int, std::string>>& offenders, const Context& ctx) {
-  std::vector<std::pair<int, std::string>> ahead_offenders;
-  std::optional<core::AheadRun<Expected<SliceResult>>> ahead;
-  if (job.engine.engine != Engine::builtin)
-    ahead.emplace(ctx, [&](const Context& c) {
-      return attempt(mesh, job, pre, excluded, &ahead_offenders, nullptr, false, c);
-    });
   ctx.progress("shell", 0);
-  std::vector<layers::ShellPlan> shells = ahead ? plan_beside(mesh, pre.analysis, job, *ahead, ctx)
-                                                : shells_for(mesh, pre.analysis, job, ctx);
+  std::vector<layers::ShellPlan> shells = shells_for(mesh, pre.analysis, job, ctx);
   if (ctx.cancelled()) return Error{Status::cancelled, "cancelled"};
   const double area = area_of(pre.analysis, stacked_patches(stacked.plan));
   const bool larger = area_of(pre.analysis, shell_patches(shells)) > 2 * area;
@@ -531,33 +500,18 @@ Expected<std::optional<SliceResult>> shell_before_stacks(
         {Notice::Kind::shell_refused, -1,
          patch_names(first.patches) + " not printed as a shell: " + first.refused});
   if (shells.front().refused.empty() && larger) {
-    // A shell that may print: the cores go to it (should it not, the stacks are sliced again).
-    if (ahead && shells.front().region.empty()) ahead->drop();
     auto why = [&](double curved) {
       char buf[160];
       std::snprintf(buf, sizeof buf, "its %.0f mm² print curved, where stacks would cover %.0f mm²",
                     curved, area);
       return std::string(buf);
     };
-    // The early engine, unless the stacks' run (still going) may take it.
-    EarlyEngine* early = ahead && ahead->running() ? nullptr : pre.engine.get();
-    auto shell =
-        try_shells(mesh, job, pre.analysis, std::move(shells), why, 2 * area, stacked, early, ctx);
+    auto shell = try_shells(mesh, job, pre.analysis, std::move(shells), why, 2 * area, stacked,
+                            pre.engine.get(), ctx);
     if (!shell || *shell) return shell;
   }
-  // The plans go before the stacks are mapped back, and the idle plan's thread had an
-  // allocator arena of its own, which keeps what was freed in it: handed back (the bunny's
-  // peak through PrusaSlicer 359 MB with it kept, 317 MB without; 324 MB planned in turn).
-  std::vector<layers::ShellPlan>().swap(shells);
-#if defined(__GLIBC__) && !defined(NONPLANAR_SHADOW_MEMORY)
-  if (ahead) malloc_trim(0);
-#endif
-  if (ahead && ahead->running()) {
-    stacks = ahead->get();
-    offenders = std::move(ahead_offenders);
-  } else {
-    stacks = attempt(mesh, job, pre, excluded, &offenders, nullptr, false, ctx);
-  }
+  std::vector<layers::ShellPlan>().swap(shells);  // gone before the stacks are sliced
+  stacks = attempt(mesh, job, pre, excluded, &offenders, nullptr, false, ctx);
   return std::optional<SliceResult>{};
 }
 

@@ -44,6 +44,12 @@ double bead_spacing(double width, double height) {
   return width - height * (1.0 - M_PI / 4.0);
 }
 
+double filament_per_mm(double width, double height, const GcodeParams& g) {
+  const double area = height * bead_spacing(width, height);  // rectangle with round ends
+  const double filament = M_PI * 0.25 * g.filament_diameter * g.filament_diameter;
+  return area / filament * g.extrusion_multiplier;
+}
+
 namespace {
 
 using paths::ExPolygons;

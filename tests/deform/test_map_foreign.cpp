@@ -155,6 +155,77 @@ TEST(MapForeignGcode, LayersMappedSideBySideWriteWhatOneAtATimeDoes) {
   EXPECT_NE(c.error().message.find("mapped points"), std::string::npos) << c.error().message;
 }
 
+// Paths given by before_layer go between the file's layers, each a layer of its own: the
+// file's retractions still balance (the filament pulled back for the travel to them is owed to
+// the file's next E), the filament pushed is the file's and theirs, and the nozzle, waiting
+// over them after the last, comes down only where the file's next move in X or Y goes. In
+// absolute and in relative E.
+TEST(MapForeignGcode, PathsInsertedBetweenLayersKeepTheFilesFilament) {
+  for (const bool relative : {false, true}) {
+    PrintConfig c;
+    c.gcode.relative_e = relative;
+    const TriangleMesh box = test::placed(test::box(Vec3(0, 0, 0), Vec3(10, 10, 2)), c);
+    auto paths = make_toolpaths(*slice_mesh(box, c.slice, {}), c.paths, {});
+    ASSERT_TRUE(paths);
+    const std::string planar = *make_gcode(*paths, c, {}, {});
+    const auto field = planar_field({});
+    // A path over the box's middle, before layer 4 (0.8 … 1.0 mm) and rising over its top, as a
+    // shell's piece may (by s⁻): the layer change after it would go down into it.
+    const Vec3 mid = 0.5 * (bounding_box(box).min + bounding_box(box).max);
+    LayerToolpaths piece;
+    ExtrusionPath p;
+    p.role = ExtrusionRole::top_solid_infill, p.width = 0.45, p.speed = 20;
+    p.points = {Vec3(mid.x() - 3, mid.y(), 1.0), Vec3(mid.x() + 3, mid.y(), 1.05)};
+    p.height = {0.2, 0.25};
+    piece.paths = {p};
+    piece.z = piece.max_z = 1.05, piece.height = 0.2, piece.nonplanar = true;
+    ForeignMapOptions opt;
+    int calls = 0;
+    opt.before_layer = [&](double z, const Vec3&) {
+      ++calls;
+      return std::abs(z - 1.0) < 1e-6 ? std::vector<LayerToolpaths>{piece}
+                                      : std::vector<LayerToolpaths>{};
+    };
+    opt.filament_per_mm = [&](double w, double h) { return filament_per_mm(w, h, c.gcode); };
+    auto plain = map_foreign_gcode(planar, *field, {}, {}, {});
+    auto with = map_foreign_gcode(planar, *field, {}, {}, opt);
+    ASSERT_TRUE(plain && with);
+    const std::size_t n = plain->layers.size();
+    EXPECT_EQ(calls, static_cast<int>(n) + 1);  // before each layer, and after the last
+    ASSERT_EQ(with->layers.size(), n + 1);
+    ASSERT_EQ(with->inserted.size(), n + 1);
+    EXPECT_EQ(std::count(with->inserted.begin(), with->inserted.end(), 1), 1);
+    EXPECT_EQ(with->inserted[4], 1);  // after layers 0-3 (tops 0.2 … 0.8)
+    EXPECT_EQ(with->layers[4].paths.size(), 1u);
+    const std::string a = plain->text(), b = with->text();
+    auto count = [](const std::string& t, const std::string& w) {
+      std::size_t k = 0;
+      for (auto at = t.find(w); at != std::string::npos; at = t.find(w, at + 1)) ++k;
+      return k;
+    };
+    EXPECT_EQ(count(b, ";LAYER_CHANGE"), count(a, ";LAYER_CHANGE") + 1);
+    const GcodeProgram pa = read_gcode_program(a), pb = read_gcode_program(b);
+    auto net = [](const GcodeProgram& g) {
+      double e = 0;
+      for (const GcodeMove& m : g.moves) e += m.de;
+      return e;
+    };
+    const double len = (p.points[1] - p.points[0]).norm();
+    const double want = len * filament_per_mm(0.45, 0.225, c.gcode);
+    EXPECT_NEAR(net(pb) - net(pa), want, 1e-3) << (relative ? "relative" : "absolute");
+    // After the path's last point, nothing goes below its top within 1 mm of it before a move
+    // in X or Y has taken the nozzle away.
+    std::size_t k = 0;
+    while (k < pb.moves.size() && !(pb.moves[k].extruding() && pb.moves[k].to.z() > 1.04)) ++k;
+    ASSERT_LT(k, pb.moves.size());
+    for (++k; k < pb.moves.size(); ++k) {
+      const GcodeMove& m = pb.moves[k];
+      if ((m.to.head<2>() - p.points[1].head<2>()).norm() > 1.0) break;
+      EXPECT_GE(m.to.z(), 1.05 - 1e-6) << "line " << m.line;
+    }
+  }
+}
+
 TEST(MapForeignGcode, RefusesWhatItCannotMapNamingTheLine) {
   const auto field = planar_field({});
   const std::string head = "M82\nG28\n;LAYER_CHANGE\n;Z:0.2\n;HEIGHT:0.2\nG1 X1 Y1 E1\n";
