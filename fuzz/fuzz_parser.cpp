@@ -178,6 +178,29 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   o.start = Vec3(100, 100, 3);
   o.start_retracted = 0.8;
   (void)map_foreign_gcode(in, field, {}, {}, o);
+  // With a path inserted before every other layer (a shell's piece, near the nozzle): each
+  // one a layer of the gate's, flagged as inserted.
+  ForeignMapOptions ins = o;
+  std::size_t given = 0;
+  ins.before_layer = [&](double z, const Vec3& at) {
+    std::vector<LayerToolpaths> out;
+    if (given++ % 2) return out;
+    LayerToolpaths L;
+    ExtrusionPath p;
+    p.width = 0.45, p.speed = 30;
+    const double top = std::isfinite(z) ? z : at.z();
+    p.points = {Vec3(at.x() + 1, at.y(), top + 0.05), Vec3(at.x() + 3, at.y() + 1, top + 0.1)};
+    p.height = {0.2, 0.25};
+    L.paths = {p};
+    L.z = L.max_z = top + 0.1;
+    out.push_back(std::move(L));
+    return out;
+  };
+  ins.filament_per_mm = [](double w, double h) { return w * h / 2.4; };
+  const auto inserted = map_foreign_gcode(in, field, {}, {}, ins);
+  if (inserted && !inserted->inserted.empty() &&
+      inserted->inserted.size() != inserted->layers.size())
+    __builtin_trap();
   // Some of its lines spliced as the shell route splits a plate (program/splice_lines.hpp),
   // a third of them another object's, then mapped as its core.
   const GcodeProgram prog = read_gcode_program(in);
