@@ -12,7 +12,8 @@
 // curved layers rises above the layer's highest point (or, for a hop under 0.6 mm, its
 // slope's reach) and comes down at the target, as the built-in writer does. Each layer is
 // built as steps (ProgramLayer) and written by the one writer; the result is three blocks,
-// start, print and end, which the shell route joins.
+// start, print and end, which the shell route joins. Paths another stage made (a shell's
+// pieces where the part stands above it) can be written between the file's layers.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -146,11 +147,11 @@ void add_travel(const GcodeMove& m, const LayerField& field, const MapBackParams
 
 // Paths printed between the file's layers (ForeignMapOptions::before_layer), as the built-in
 // writer prints its own: each piece a layer, each path travelled to lifted over what is
-// printed, pulled back by the
-// file's retraction on the way and given it back there, then extruded by the printer's
-// filament model at each point's height. After the last the filament stays pulled back (owed
-// to the file's next E, so that its own retractions balance as it wrote them) and the nozzle
-// waits lifted where it ended: the file's next layer change would lower it into them there.
+// printed, pulled back by the file's retraction on the way and given it back there, then
+// extruded by the printer's filament model at each point's height. After the last the filament
+// stays pulled back (owed to the file's next E, so that its own retractions balance as it wrote
+// them) and the nozzle waits lifted where it ended: the file's next layer change would lower it
+// into them there.
 void write_inserted(std::vector<LayerToolpaths>& pieces, const GcodeRetraction& r,
                     const MapBackParams& params, const ForeignMapOptions& o, Writing& s) {
   const double travel_f = 60 * o.inserted_travel_speed;
@@ -433,7 +434,10 @@ Expected<ForeignGcode> map_foreign_gcode(std::string_view text, const LayerField
   s.pending = options.start_retracted;
   std::vector<char> dropped;
   program::MovePaths mapped(0);
-  InOrder o{prog, mapped, field, params, options, out, s, dropped, first_retraction(text)};
+  // (Only a clip and inserted paths retract on their own.)
+  const GcodeRetraction retraction =
+      options.clip || options.before_layer ? first_retraction(text) : GcodeRetraction{};
+  InOrder o{prog, mapped, field, params, options, out, s, dropped, retraction};
   const std::size_t window = std::max<std::size_t>(1, options.layers_at_once);
   bool placed = false, first = true;
   while (reader.next(window) && reader.piece() == GcodePieceReader::Piece::layers) {

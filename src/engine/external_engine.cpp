@@ -482,7 +482,9 @@ std::optional<Expected<std::string>> run_early(EarlyEngine& early, const EngineP
   l.waiting = false;
   auto fed =
       feed(l, {{l.settings, run_settings(c, run, first_layer)}, {l.input, std::move(amf)}}, ctx);
-  return fed ? finish(l, e, c, ctx) : Expected<std::string>(fed.error());
+  if (!fed) return Expected<std::string>(fed.error());
+  if (run.handed_over) run.handed_over();
+  return finish(l, e, c, ctx);
 }
 
 }  // namespace
@@ -518,6 +520,7 @@ Expected<std::string> run_engine(const EngineParams& e, const TriangleMesh& mesh
   if (!args) return args.error();
   if (auto s = spawn(l, std::move(*args), orca ? "OrcaSlicer" : "PrusaSlicer"); !s)
     return s.error();
+  if (run.handed_over) run.handed_over();
   return finish(l, e, c, ctx);
 }
 

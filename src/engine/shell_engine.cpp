@@ -307,9 +307,10 @@ Expected<EngineShell> shell_pieces_with_engine(const TriangleMesh& mesh,
                                                std::vector<layers::ShellPlan>& plans,
                                                const EngineRoute& job, const Context& ctx) {
   const std::vector<double> tops(plans.front().core.begin() + 1, plans.front().core.end());
-  // The shells' curved layers, cut into their slots, beside the engine's run of the core.
+  // The shells' curved layers, cut into their slots, beside the engine's run of the core
+  // once it has the part (not beside the part's text for it).
   using Slots = std::vector<std::vector<LayerToolpaths>>;
-  core::AheadRun<Expected<Slots>> ahead(ctx, [&](const Context& c) -> Expected<Slots> {
+  auto slice_shells = [&](const Context& c) -> Expected<Slots> {
     std::vector<std::vector<LayerToolpaths>> shells;
     for (const layers::ShellPlan& plan : plans) {
       const std::vector<ExPolygon> R = layers::region_at_least(plan.region.as_top(), 0);
@@ -318,13 +319,17 @@ Expected<EngineShell> shell_pieces_with_engine(const TriangleMesh& mesh,
       shells.push_back(std::move(*paths));
     }
     return shell_slots(shells, plans, tops);
-  });
+  };
+  std::optional<core::AheadRun<Expected<Slots>>> ahead;
   ctx.progress("engine", 0);
   EngineRun run;
   run.layer_tops = tops;
+  run.handed_over = [&] {
+    if (!ahead) ahead.emplace(ctx, slice_shells);
+  };
   auto text = run_engine(job.engine, mesh, job.print, ctx, run, job.early);
   if (!text) return text.error();
-  auto slots = ahead.get();
+  auto slots = ahead ? ahead->get() : slice_shells(ctx);
   if (!slots) return slots.error();
   for (layers::ShellPlan& plan : plans) plan.slack = {};  // (the slots are cut)
 #if defined(__GLIBC__) && !defined(NONPLANAR_SHADOW_MEMORY)
