@@ -187,10 +187,9 @@ Expected<ForeignGcode> map_core(std::string_view core_text,
                                 const Context& ctx, ForeignMapOptions opt) {
   const layers::ShellPlan& plan = plans.front();
   const CoreClip clip(plans, 0.5 * job.print.paths.perimeter_width);
-  ForeignMapOptions& core_opt = opt;
-  core_opt.clip = &clip;
+  opt.clip = &clip;
   const auto planar = planar_field(job.layers);
-  auto core = map_foreign_gcode(core_text, *planar, job.map_back, ctx, core_opt);
+  auto core = map_foreign_gcode(core_text, *planar, job.map_back, ctx, opt);
   if (!core) {
     Error e = core.error();
     e.message = "engine G-code (core), " + e.message;

@@ -151,5 +151,42 @@ TEST(NodeMask, ValuesAreTheBilinearOfItsSigns) {
   EXPECT_EQ(m.value(3, -2), m.in[0]);  // a node
 }
 
+// A mask's signed distance has the mask's sign everywhere (the same cut), is ±1 next to the
+// other side, is the chessboard distance at nodes, and changes by at most one a cell (what
+// the engine route's core clip steps by).
+TEST(NodeDistance, HasTheMasksSignAndIsTheChessboardDistance) {
+  layers::NodeMask m;
+  m.origin = {3, -2}, m.cell = 0.13, m.nx = 37, m.ny = 23;
+  std::mt19937 rng(11);
+  for (int i = 0; i < m.nx; ++i)  // a disc of radius 8 cells with a few holes and specks
+    for (int j = 0; j < m.ny; ++j) {
+      const bool in = std::hypot(i - 18, j - 11) < 8;
+      m.in.push_back((in != (rng() % 23 == 0)) ? 1 : -1);
+    }
+  const layers::NodeDistance d = layers::signed_distance(m);
+  ASSERT_EQ(d.d.size(), m.in.size());
+  auto at = [&](int i, int j) {
+    return static_cast<std::size_t>(i) * 23 + static_cast<std::size_t>(j);
+  };
+  for (int i = 0; i < m.nx; ++i)
+    for (int j = 0; j < m.ny; ++j) {
+      int nearest = 1 << 20;  // brute force: the chessboard distance to the other side
+      for (int a = 0; a < m.nx; ++a)
+        for (int b = 0; b < m.ny; ++b)
+          if (m.in[at(a, b)] != m.in[at(i, j)])
+            nearest = std::min(nearest, std::max(std::abs(a - i), std::abs(b - j)));
+      ASSERT_EQ(d.d[at(i, j)], m.in[at(i, j)] > 0 ? -nearest : nearest) << i << ", " << j;
+      if (i + 1 < m.nx && m.in[at(i + 1, j)] == m.in[at(i, j)]) {
+        EXPECT_LE(std::abs(d.d[at(i + 1, j)] - d.d[at(i, j)]), 1);
+      }
+    }
+  std::uniform_real_distribution<double> x(2, 9), y(-3, 2);
+  for (int k = 0; k < 20000; ++k) {
+    const double px = x(rng), py = y(rng);
+    ASSERT_LE(d.value(px, py) * m.value(px, py), 0) << px << ", " << py;  // opposite signs
+    ASSERT_EQ(d.value(px, py) == 0, m.value(px, py) == 0) << px << ", " << py;
+  }
+}
+
 }  // namespace
 }  // namespace nonplanar
