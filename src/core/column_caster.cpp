@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 namespace nonplanar {
 
@@ -32,24 +33,28 @@ ColumnCaster::ColumnCaster(const TriangleMesh& mesh, double cell) : mesh_(mesh),
 
 namespace {
 
+// Where face f meets the vertical line at (x, y): its height, and +1 entering / −1 leaving.
+std::optional<std::pair<double, int>> hit(const TriangleMesh& m, int f, double x, double y) {
+  const auto& t = m.faces[static_cast<std::size_t>(f)];
+  const Vec3 &a = m.vertices[t[0]], &b = m.vertices[t[1]], &c = m.vertices[t[2]];
+  // Barycentric coordinates in XY, with a little slack so a line through a shared edge
+  // or vertex is claimed by every face there (rounding must not drop it).
+  const double d = (b.x() - a.x()) * (c.y() - a.y()) - (c.x() - a.x()) * (b.y() - a.y());
+  if (d == 0.0) return std::nullopt;  // vertical triangle: the line grazes it
+  const double l1 = ((x - a.x()) * (c.y() - a.y()) - (c.x() - a.x()) * (y - a.y())) / d;
+  const double l2 = ((b.x() - a.x()) * (y - a.y()) - (x - a.x()) * (b.y() - a.y())) / d;
+  const double l0 = 1.0 - l1 - l2;
+  if (l0 < -1e-12 || l1 < -1e-12 || l2 < -1e-12) return std::nullopt;
+  return std::pair(l0 * a.z() + l1 * b.z() + l2 * c.z(), d > 0 ? -1 : +1);  // d > 0: normal up
+}
+
 // (height, +1 entering / −1 leaving) of every face the vertical line at (x, y) meets.
 std::vector<std::pair<double, int>> signed_hits(const TriangleMesh& m,
                                                 const std::vector<int>& faces, double x, double y) {
   std::vector<std::pair<double, int>> hits;
-  for (int f : faces) {
-    const auto& t = m.faces[f];
-    const Vec3 &a = m.vertices[t[0]], &b = m.vertices[t[1]], &c = m.vertices[t[2]];
-    // Barycentric coordinates in XY, with a little slack so a line through a shared edge
-    // or vertex is claimed by every face there (rounding must not drop it); copies with
-    // the same height and direction are merged below.
-    const double d = (b.x() - a.x()) * (c.y() - a.y()) - (c.x() - a.x()) * (b.y() - a.y());
-    if (d == 0.0) continue;  // vertical triangle: the line grazes it
-    const double l1 = ((x - a.x()) * (c.y() - a.y()) - (c.x() - a.x()) * (y - a.y())) / d;
-    const double l2 = ((b.x() - a.x()) * (y - a.y()) - (x - a.x()) * (b.y() - a.y())) / d;
-    const double l0 = 1.0 - l1 - l2;
-    if (l0 < -1e-12 || l1 < -1e-12 || l2 < -1e-12) continue;
-    hits.emplace_back(l0 * a.z() + l1 * b.z() + l2 * c.z(), d > 0 ? -1 : +1);  // d > 0: normal up
-  }
+  // Copies with the same height and direction (a shared edge's faces) are merged below.
+  for (int f : faces)
+    if (const auto h = hit(m, f, x, y)) hits.push_back(*h);
   // Entering before leaving at equal heights, so touching shells stay one interval.
   std::sort(hits.begin(), hits.end(), [](const auto& p, const auto& q) {
     return p.first < q.first - 1e-9 || (std::abs(p.first - q.first) <= 1e-9 && p.second > q.second);
@@ -63,6 +68,16 @@ std::vector<std::pair<double, int>> signed_hits(const TriangleMesh& m,
 }
 
 }  // namespace
+
+std::vector<std::pair<double, int>> ColumnCaster::face_hits(double x, double y) const {
+  std::vector<std::pair<double, int>> out;
+  const int i = static_cast<int>(std::floor((x - origin_.x()) / cell_));
+  const int j = static_cast<int>(std::floor((y - origin_.y()) / cell_));
+  if (i < 0 || j < 0 || i >= nx_ || j >= ny_) return out;
+  for (int f : bins_[static_cast<std::size_t>(i) * ny_ + j])
+    if (const auto h = hit(mesh_, f, x, y)) out.emplace_back(h->first, f);
+  return out;
+}
 
 std::vector<double> ColumnCaster::crossings(double x, double y) const {
   std::vector<double> z;

@@ -17,6 +17,9 @@ class ColumnCaster {
   /// Material intervals [z_lo, z_hi] along the line, by winding number (a face whose normal
   /// points down enters material, up leaves it), so touching or overlapping shells merge.
   std::vector<std::pair<double, double>> intervals(double x, double y) const;
+  /// (height, face index) of each face the vertical line at (x, y) meets, unsorted (at an
+  /// edge or vertex, every face there).
+  std::vector<std::pair<double, int>> face_hits(double x, double y) const;
   /// Is (x, y, z) inside the material?
   bool inside(double x, double y, double z) const;
 

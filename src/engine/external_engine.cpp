@@ -16,10 +16,11 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <memory>
 #include <optional>
-#include <sstream>
 #include <thread>
 
+#include "core/ahead_run.hpp"
 #include "core/mesh_topology.hpp"
 #include "nonplanar/io.hpp"
 
@@ -405,10 +406,19 @@ Expected<std::string> finish(Launch& l, const EngineParams& e, const PrintConfig
     const std::string why = last_line(l.log);
     return Error{Status::io_error, "engine: " + name + " failed" + (why.empty() ? "" : ": " + why)};
   }
-  std::ifstream in(result, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  std::string gcode = text.str();
+  // Read into its own room (a string stream's buffer and its copy were 2.7 times the bunny's
+  // 19 MB at once), with some over for the config block complete_config_block may add.
+  std::string gcode;
+  {
+    std::ifstream in(result, std::ios::binary | std::ios::ate);
+    const std::streamoff size = in ? static_cast<std::streamoff>(in.tellg()) : 0;
+    gcode.reserve(static_cast<std::size_t>(std::max<std::streamoff>(size, 0)) + (64 << 10));
+    gcode.resize(static_cast<std::size_t>(std::max<std::streamoff>(size, 0)));
+    in.seekg(0);
+    if (!in.read(gcode.data(), size))
+      return Error{Status::io_error,
+                   "engine: cannot read " + name + "'s G-code " + result.string()};
+  }
   if (!ends_complete(gcode))
     return Error{Status::io_error,
                  "engine: " + name +
@@ -425,6 +435,16 @@ struct EarlyEngine {
   Launch launch{"part.amf.xml"};
   Vec2 centre;
   std::atomic<bool> taken{false};
+  /// Started beside a run handed over ahead, for the run that stops that one instead.
+  EarlyEnginePtr spare;
+  /// A run handed over ahead (run_engine_ahead): what it was given, and its G-code to come
+  /// (none: the mesh could not go as AMF). Stopped before `launch` is.
+  struct Ahead {
+    const TriangleMesh* mesh = nullptr;
+    EngineRun run;
+    std::optional<core::AheadRun<std::optional<Expected<std::string>>>> gcode;
+  };
+  std::unique_ptr<Ahead> ahead;
 };
 
 void EarlyEngineDeleter::operator()(EarlyEngine* p) const {
@@ -466,10 +486,10 @@ std::vector<double> run_tops(const BoundingBox& box, const EngineRun& run) {
 // The run given to the engine started early: its layer heights, then the mesh as AMF (with
 // the profile, if any), as the engine opens the two pipes. Empty: it cannot take this mesh
 // (faces that collapse in float: the STL of a run started late lets PrusaSlicer repair them).
-std::optional<Expected<std::string>> run_early(EarlyEngine& early, const EngineParams& e,
-                                               const TriangleMesh& mesh, const BoundingBox& box,
-                                               const PrintConfig& c, const Context& ctx,
-                                               const EngineRun& run, double first_layer) {
+std::optional<Expected<void>> hand_over(EarlyEngine& early, const TriangleMesh& mesh,
+                                        const BoundingBox& box, const PrintConfig& c,
+                                        const Context& ctx, const EngineRun& run,
+                                        double first_layer) {
   std::size_t collapsed = 0;
   std::vector<std::pair<std::string, std::string>> metadata;
   if (!run.layer_tops.empty())
@@ -480,11 +500,75 @@ std::optional<Expected<std::string>> run_early(EarlyEngine& early, const EngineP
   if (collapsed != 0) return std::nullopt;
   Launch& l = early.launch;
   l.waiting = false;
-  auto fed =
-      feed(l, {{l.settings, run_settings(c, run, first_layer)}, {l.input, std::move(amf)}}, ctx);
-  if (!fed) return Expected<std::string>(fed.error());
+  return feed(l, {{l.settings, run_settings(c, run, first_layer)}, {l.input, std::move(amf)}}, ctx);
+}
+
+// hand_over, then the engine's G-code.
+std::optional<Expected<std::string>> run_early(EarlyEngine& early, const EngineParams& e,
+                                               const TriangleMesh& mesh, const BoundingBox& box,
+                                               const PrintConfig& c, const Context& ctx,
+                                               const EngineRun& run, double first_layer) {
+  auto fed = hand_over(early, mesh, box, c, ctx, run, first_layer);
+  if (!fed) return std::nullopt;
+  if (!*fed) return Expected<std::string>(fed->error());
   if (run.handed_over) run.handed_over();
-  return finish(l, e, c, ctx);
+  return finish(early.launch, e, c, ctx);
+}
+
+}  // namespace
+
+void run_engine_ahead(EarlyEngine& early, const EngineParams& e, const TriangleMesh& mesh,
+                      const PrintConfig& c, EngineRun run, const Context& ctx) {
+  const BoundingBox box = bounding_box(mesh);
+  if (e.engine != Engine::prusaslicer || 0.5 * (box.min + box.max).head<2>() != early.centre ||
+      early.taken.exchange(true))
+    return;
+  const double h1 =
+      run.layer_tops.empty() ? c.slice.first_layer_height : run.layer_tops.front() - box.min.z();
+  // Another one waits for the run that is asked for if this one is not (its start is most of a
+  // small part's run: the Voron cube's slice took 9 % longer without it).
+  early.spare = start_engine_early(e, c, mesh);
+  // A large mesh is handed over here, so that its AMF text is gone before the shells are
+  // planned (beside them Benchy's 25 MB raised the peak from 114 to 154 MB); a small one beside
+  // them, not waiting for the engine to be ready to read it (0.3 s on the bunny).
+  constexpr std::size_t kLargeAmf = 8u << 20;  // bytes, at 72 a face (amf_text)
+  using Fed = std::optional<Expected<void>>;
+  std::optional<Fed> fed;
+  if (72 * mesh.faces.size() > kLargeAmf) fed = hand_over(early, mesh, box, c, ctx, run, h1);
+  early.ahead = std::make_unique<EarlyEngine::Ahead>();
+  EarlyEngine::Ahead& a = *early.ahead;
+  a.mesh = &mesh, a.run = std::move(run);
+  a.gcode.emplace(ctx, [&early, &a, &e, &mesh, &c, box, h1,
+                        fed = std::move(fed)](const Context& inner) mutable {
+    using Result = std::optional<Expected<std::string>>;
+    if (!fed) fed = hand_over(early, mesh, box, c, inner, a.run, h1);
+    if (!*fed) return Result{};
+    if (!**fed) return Result(Expected<std::string>((*fed)->error()));
+    return Result(finish(early.launch, e, c, inner));
+  });
+}
+
+namespace {
+
+// The G-code of the run handed over ahead, when this is that run (else that run is stopped,
+// and `early` becomes the spare engine started beside it): none when it is not, or when it
+// failed as run_early's runs may (run then as one started late).
+std::optional<Expected<std::string>> take_ahead(EarlyEngine*& early, const TriangleMesh& mesh,
+                                                const EngineRun& run) {
+  if (!early || !early->ahead) return std::nullopt;
+  const std::unique_ptr<EarlyEngine::Ahead> a = std::move(early->ahead);
+  const bool same = a->mesh == &mesh && a->run.layer_tops == run.layer_tops &&
+                    a->run.layer_height == run.layer_height && run.support_blockers.empty() &&
+                    a->run.support_blockers.empty();
+  if (!same) {  // (a's engine stopped as it goes)
+    early = early->spare.get();
+    return std::nullopt;
+  }
+  if (run.handed_over) run.handed_over();
+  std::optional<Expected<std::string>> gcode = a->gcode->get();
+  if (gcode && (*gcode || gcode->error().status != Status::io_error)) return gcode;
+  early = early->spare.get();
+  return std::nullopt;
 }
 
 }  // namespace
@@ -492,6 +576,7 @@ std::optional<Expected<std::string>> run_early(EarlyEngine& early, const EngineP
 Expected<std::string> run_engine(const EngineParams& e, const TriangleMesh& mesh,
                                  const PrintConfig& c, const Context& ctx, const EngineRun& run,
                                  EarlyEngine* early) {
+  if (auto gcode = take_ahead(early, mesh, run)) return std::move(*gcode);
   const bool orca = e.engine == Engine::orcaslicer;
   const BoundingBox box = bounding_box(mesh);
   // Where the part is: the engine centres its box there.

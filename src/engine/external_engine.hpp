@@ -83,6 +83,15 @@ Expected<std::string> run_engine(const EngineParams& e, const TriangleMesh& mesh
                                  const PrintConfig& c, const Context& ctx,
                                  const EngineRun& run = {}, EarlyEngine* early = nullptr);
 
+/// Hands the engine started early `run` of `mesh` now, before the caller knows it needs it (a
+/// shell core's boundaries, foreseen while the shells are planned): the run goes on beside the
+/// caller, and the run_engine call given `early` with the same mesh (object) and run (layer tops
+/// and height, no blockers) takes its G-code (its handed_over called at once). Any other call
+/// given `early` stops it first and starts its own engine. The mesh, e and c must outlive
+/// `early`. Nothing is done when `early` was taken or expects a mesh centred elsewhere.
+void run_engine_ahead(EarlyEngine& early, const EngineParams& e, const TriangleMesh& mesh,
+                      const PrintConfig& c, EngineRun run, const Context& ctx);
+
 /// For a signal handler (async-signal-safe): SIGKILL the running engines' process groups (an
 /// early one may wait); each run_engine() then returns and
 /// removes its folder. True if one ran.

@@ -4,7 +4,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
+#include "core/column_caster.hpp"
 #include "core/parallel.hpp"
 
 namespace nonplanar::layers {
@@ -35,6 +37,52 @@ std::vector<double> core_boundaries(double h1, double h_c, double h_min, double 
   }
   while (cur < end - 1e-9) z.push_back(cur += h_c);
   return z;
+}
+
+// The core's layer height: the shell's lowest layer fills a stair of up to h_c over t − a and
+// stays within the layer limits (kMargin inside them).
+double core_layer_height(const LayerParams& p) {
+  return std::min(p.layer_height, p.max_layer_height - p.min_layer_height - 2 * kMargin);
+}
+
+// The shell's t, N and reach over `patches`.
+void set_layers(ShellPlan& s, const Analysis& a, const std::vector<int>& patches,
+                const LayerParams& p) {
+  // As thick as the nozzle tip's flat needs on the steepest facet (stack_builder's rule: a
+  // layer thinner than (r + 0.1)·tan θ − h/2 fires the collision test uphill), else the
+  // profile's layer height: at 0.15 mm and 30° the shell's layers must be 0.22 mm.
+  double steepest = 0;
+  for (int i : patches)
+    steepest = std::max(steepest, a.patches[static_cast<std::size_t>(i)].max_slope_deg);
+  const double tip =
+      (p.toolhead.tip_radius + 0.1) * std::tan(steepest * kDeg) - 0.5 * p.layer_height;
+  s.t = std::max(p.layer_height, std::ceil(tip * 100 - 1e-9) / 100);
+  s.reach = s.t - p.min_layer_height - kMargin;
+  // A shell of about two layers: the core prints its own top solid layers under it, so the
+  // shell only has to fill the stairs and lay the top; each layer more costs print time and
+  // gains nothing measurable (four against two on ten real parts: the share within 0.03 mm
+  // moved by at most 0.009, the prints took 2-22 % longer). Features below keep planar layers.
+  s.N = p.shell_layers > 0 ? p.shell_layers
+                           : std::max(2, static_cast<int>(std::ceil(0.4 / s.t - 1e-9)));
+}
+
+// The core's first layer: the profile's where no stair of the shell's lowest layer comes down
+// to it (B + a >= z_1 wherever H is, `lowest` the least of H − N·t + a): a slicer that slices
+// the core in the same run as the shell (prepare) prints its own first layer height. Else at
+// most h_c, as every stair.
+double core_first_layer(double lowest, const LayerParams& p) {
+  return lowest >= p.first_layer_height + 1e-6
+             ? p.first_layer_height
+             : std::min(p.first_layer_height, core_layer_height(p));
+}
+
+// The heights the core's boundaries land on: the flat patches' (none on an even core).
+std::vector<double> core_targets(const Analysis& a, bool even_core) {
+  std::vector<double> targets;
+  for (const Patch& q : a.patches)
+    if (!even_core && q.verdict == PatchVerdict::flat && q.z_max - q.z_min < 0.05)
+      targets.push_back(0.5 * (q.z_min + q.z_max));  // the wing's tilted floor: 3.55–3.58 mm
+  return targets;
 }
 
 // Overhangs (leaning over 45°) and other printable up-facing surfaces (not of the patches) within
@@ -141,7 +189,7 @@ void take_region(ShellPlan& s, ShellRegion&& r) {
     s.left_out = buf;
     for (std::size_t k = 0; k < r.why_out.size(); ++k) s.left_out += (k ? "; " : "") + r.why_out[k];
   }
-  s.banded = r.banded;
+  s.banded = r.banded, s.stands_at = r.stands_at;
   s.region = std::move(r.mask);
   s.slack = std::move(r.slack);
   s.levels = std::move(r.levels);
@@ -245,28 +293,12 @@ ShellPlan plan_shell(const TriangleMesh& mesh, const Analysis& a, const std::vec
     return s;
   }
   const BoundingBox box = bounding_box(mesh);
-  // As thick as the nozzle tip's flat needs on the steepest facet (stack_builder's rule: a
-  // layer thinner than (r + 0.1)·tan θ − h/2 fires the collision test uphill), else the
-  // profile's layer height: at 0.15 mm and 30° the shell's layers must be 0.22 mm.
-  double steepest = 0;
-  for (int i : patches)
-    steepest = std::max(steepest, a.patches[static_cast<std::size_t>(i)].max_slope_deg);
-  const double tip =
-      (p.toolhead.tip_radius + 0.1) * std::tan(steepest * kDeg) - 0.5 * p.layer_height;
-  s.t = std::max(p.layer_height, std::ceil(tip * 100 - 1e-9) / 100);
-  const double h_c =
-      std::min(p.layer_height, p.max_layer_height - p.min_layer_height - 2 * kMargin);
+  const double h_c = core_layer_height(p);
+  set_layers(s, a, patches, p);
   if (h_c < p.min_layer_height || s.t < p.min_layer_height || s.t > p.max_layer_height) {
     s.refused = "the layer limits leave no room for the core's stairs under a shell";
     return s;
   }
-  s.reach = s.t - p.min_layer_height - kMargin;
-  // A shell of about two layers: the core prints its own top solid layers under it, so the
-  // shell only has to fill the stairs and lay the top; each layer more costs print time and
-  // gains nothing measurable (four against two on ten real parts: the share within 0.03 mm
-  // moved by at most 0.009, the prints took 2-22 % longer). Features below keep planar layers.
-  s.N = p.shell_layers > 0 ? p.shell_layers
-                           : std::max(2, static_cast<int>(std::ceil(0.4 / s.t - 1e-9)));
   // H over the part's footprint (a pad as wide on every side as the patches' farthest side
   // needs); with a frame, over the patches' surroundings only (a further shell: the bunny's
   // tail took a raster twice the bunny's size, 0.5 s a plan).
@@ -313,21 +345,65 @@ ShellPlan plan_shell(const TriangleMesh& mesh, const Analysis& a, const std::vec
   double end = 0;
   for (double h : s.top.h) end = std::max(end, h - s.N * s.t + s.reach);
   end = std::min(end, box.max.z());
-  std::vector<double> targets;
-  for (const Patch& q : a.patches)
-    if (!even_core && q.verdict == PatchVerdict::flat && q.z_max - q.z_min < 0.05)
-      targets.push_back(0.5 * (q.z_min + q.z_max));  // the wing's tilted floor: 3.55–3.58 mm
-  if (!s.region.empty()) end = box.max.z();          // the part outside R goes on above the shell
-  // The first layer is the profile's where no stair of the shell's lowest layer comes down to
-  // it (B + a >= z_1 all over H's raster: the layer over a stair is z_{k+1} − z_k thick, and
-  // the first layer is never that one): a slicer that slices the core in the same run as the
-  // shell (prepare) prints its own first layer height. Else at most h_c, as every stair.
+  if (!s.region.empty()) end = box.max.z();  // the part outside R goes on above the shell
+  // (The layer over a stair is z_{k+1} − z_k thick, and the first layer is never that one.)
   double lowest = 1e300;
   for (double h : s.top.h) lowest = std::min(lowest, h - s.N * s.t + s.reach);
-  const double h1 = lowest >= p.first_layer_height + 1e-6 ? p.first_layer_height
-                                                          : std::min(p.first_layer_height, h_c);
-  s.core = core_boundaries(h1, h_c, p.min_layer_height, end, targets);
+  s.core = core_boundaries(core_first_layer(lowest, p), h_c, p.min_layer_height, end,
+                           core_targets(a, even_core));
   return s;
+}
+
+std::optional<std::vector<double>> region_shells_core(const TriangleMesh& mesh, const Analysis& a,
+                                                      const LayerParams& p) {
+  // How far over H another facet must be to count (mm): shell_region's R leaves out what
+  // stands 0.02 mm above H; this test only has to foresee whether R will be all of H.
+  constexpr double kAbove = 0.1;
+  const ColumnCaster columns(mesh);
+  std::vector<char> curved(mesh.faces.size(), 0);
+  for (const Patch& q : a.patches)
+    if (q.needs_nonplanar())
+      for (int f : q.faces) curved[static_cast<std::size_t>(f)] = 1;
+  // Over each curved facet's centre: H is about the highest curved facet there, and the part
+  // stands above it where another facet is higher still.
+  bool above = false;
+  for (std::size_t f = 0; f < mesh.faces.size() && !above; ++f) {
+    if (!curved[f]) continue;
+    const auto& F = mesh.faces[f];
+    const Vec3 c = (mesh.vertices[F[0]] + mesh.vertices[F[1]] + mesh.vertices[F[2]]) / 3.0;
+    double top = c.z(), other = -std::numeric_limits<double>::infinity();
+    for (const auto& [z, g] : columns.face_hits(c.x(), c.y())) {
+      double& highest = curved[static_cast<std::size_t>(g)] ? top : other;
+      highest = std::max(highest, z);
+    }
+    above = other > top + kAbove;
+  }
+  // And under each other facet's corners (a wall rising from a curved floor's edge).
+  for (std::size_t f = 0; f < mesh.faces.size() && !above; ++f) {
+    if (curved[f]) continue;
+    for (int v : mesh.faces[f]) {
+      const Vec3& c = mesh.vertices[static_cast<std::size_t>(v)];
+      double top = -std::numeric_limits<double>::infinity();
+      for (const auto& [z, g] : columns.face_hits(c.x(), c.y()))
+        if (curved[static_cast<std::size_t>(g)]) top = std::max(top, z);
+      if (std::isfinite(top) && c.z() > top + kAbove) {
+        above = true;
+        break;
+      }
+    }
+  }
+  if (!above) return std::nullopt;
+  // The shell over all the curved patches, H as low as their lowest point (plan_shell's H may
+  // be lower beside them: the plan then has another first layer, and says so).
+  ShellPlan s;
+  std::vector<int> all;
+  double lowest = 1e300;
+  for (std::size_t i = 0; i < a.patches.size(); ++i)
+    if (a.patches[i].needs_nonplanar())
+      all.push_back(static_cast<int>(i)), lowest = std::min(lowest, a.patches[i].z_min);
+  set_layers(s, a, all, p);
+  return core_boundaries(core_first_layer(lowest - s.N * s.t + s.reach, p), core_layer_height(p),
+                         p.min_layer_height, bounding_box(mesh).max.z(), core_targets(a, false));
 }
 
 namespace {
@@ -343,8 +419,22 @@ std::vector<int> curved_among(const Analysis& a, const std::vector<int>& among) 
   return out;
 }
 
+// The shell over fewer patches than `wider`, saying why the wider one is refused (the ankle
+// base's rim prints as a shell, its ledge planar: say why not both).
+ShellPlan narrowed(ShellPlan s, const std::vector<int>& wider, const std::string& why) {
+  std::string names = wider.size() > 1 ? "a shell over patches" : "a shell over patch";
+  for (std::size_t k = 0; k < std::min<std::size_t>(wider.size(), 5); ++k)
+    names += (k ? ", " : " ") + std::to_string(wider[k]);
+  if (wider.size() > 5) names += " and " + std::to_string(wider.size() - 5) + " more";
+  s.narrowed = names + ": " + why;
+  return s;
+}
+
+// The first shell: over all the curved patches among c.among, or else the group near the
+// largest, or else the largest alone. `near_plan` (if given) gets the group's plan when all the
+// patches' is chosen beside it (choose_shells weighs it when that one is banded).
 ShellPlan choose_first(const TriangleMesh& mesh, const Analysis& a, const LayerParams& p,
-                       const ShellChoice& c) {
+                       const ShellChoice& c, ShellPlan* near_plan = nullptr) {
   const std::vector<int> all = curved_among(a, c.among);
   if (all.empty()) {
     ShellPlan none;
@@ -361,15 +451,6 @@ ShellPlan choose_first(const TriangleMesh& mesh, const Analysis& a, const LayerP
     if (k == 0) plan = plan_shell(mesh, a, all, p, 0, c.even_core, c.cancel, c.whole_only);
     if (k == 1) some = plan_shell(mesh, a, near, p, 0, c.even_core, c.cancel, c.whole_only);
   });
-  // The ankle base's rim prints as a shell, its ledge planar: say why not both.
-  auto narrowed = [&](ShellPlan s, const std::vector<int>& wider, const std::string& why) {
-    std::string names = wider.size() > 1 ? "a shell over patches" : "a shell over patch";
-    for (std::size_t k = 0; k < std::min<std::size_t>(wider.size(), 5); ++k)
-      names += (k ? ", " : " ") + std::to_string(wider[k]);
-    if (wider.size() > 5) names += " and " + std::to_string(wider.size() - 5) + " more";
-    s.narrowed = names + ": " + why;
-    return s;
-  };
   if (!plan.refused.empty() && group && some.refused.empty())
     return narrowed(std::move(some), all, plan.refused);
   if (!plan.refused.empty() && all.size() > 1) {
@@ -381,6 +462,7 @@ ShellPlan choose_first(const TriangleMesh& mesh, const Analysis& a, const LayerP
     if (one.refused.empty())
       return narrowed(std::move(one), group ? near : all, group ? some.refused : plan.refused);
   }
+  if (near_plan && group && plan.refused.empty()) *near_plan = std::move(some);
   return plan;
 }
 
@@ -402,14 +484,12 @@ std::vector<ShellPlan> choose_shells(const TriangleMesh& mesh, const Analysis& a
 
 namespace {
 
-// choose_shells as the settings say.
-std::vector<ShellPlan> shells_as_set(const TriangleMesh& mesh, const Analysis& a,
-                                     const LayerParams& p, const ShellChoice& c) {
+// After the first of `shells`, the further ones, as choose_shells says.
+void add_further(const TriangleMesh& mesh, const Analysis& a, const LayerParams& p,
+                 const ShellChoice& c, std::vector<ShellPlan>& shells) {
   const int most = c.most;
-  std::vector<ShellPlan> shells;
-  shells.push_back(choose_first(mesh, a, p, c));
   const ShellPlan& first = shells.front();
-  if (!first.refused.empty() || first.region.empty()) return shells;
+  if (!first.refused.empty() || first.region.empty()) return;
   std::vector<int> rest;
   for (int i : curved_among(a, c.among))
     if (std::find(first.patches.begin(), first.patches.end(), i) == first.patches.end())
@@ -456,6 +536,15 @@ std::vector<ShellPlan> shells_as_set(const TriangleMesh& mesh, const Analysis& a
     if (s.refused.empty() && !s.region.empty() && s.core == shells.front().core)
       shells.push_back(std::move(s));
   }
+}
+
+// choose_shells as the settings say; `near_plan` as choose_first's.
+std::vector<ShellPlan> shells_as_set(const TriangleMesh& mesh, const Analysis& a,
+                                     const LayerParams& p, const ShellChoice& c,
+                                     ShellPlan* near_plan = nullptr) {
+  std::vector<ShellPlan> shells;
+  shells.push_back(choose_first(mesh, a, p, c, near_plan));
+  add_further(mesh, a, p, c, shells);
   return shells;
 }
 
@@ -463,7 +552,8 @@ std::vector<ShellPlan> shells_as_set(const TriangleMesh& mesh, const Analysis& a
 
 std::vector<ShellPlan> choose_shells(const TriangleMesh& mesh, const Analysis& a,
                                      const LayerParams& p, const ShellChoice& c) {
-  std::vector<ShellPlan> shells = shells_as_set(mesh, a, p, c);
+  ShellPlan near;  // choose_first's plan of the group near the largest patch, if it made one
+  std::vector<ShellPlan> shells = shells_as_set(mesh, a, p, c, &near);
   // A shell banded over more than half of its patches is worth its bands (their print time,
   // and the slab over the whole part, 2.6 s of the bunny's 5.5 s slice) only where shells
   // over the regions apart, each banded less, leave a good part of it planar: the bunny's four
@@ -493,10 +583,25 @@ std::vector<ShellPlan> choose_shells(const TriangleMesh& mesh, const Analysis& a
     bytes += 8 * (s.top.h.size() + s.slack.h.size()) + s.region.in.size();
   const double banded_area = area(shells);
   const bool dropped = bytes > kLargest;
-  if (dropped) shells = {};
   LayerParams less = p;
   less.shell_max_banded = kBandedShare;
-  std::vector<ShellPlan> apart = shells_as_set(mesh, a, less, c);
+  // The shells at shell_max_banded 0.5. The first over all the patches is refused there for
+  // its bands, and choose_first then takes the group near the largest patch when that plans:
+  // as planned beside it (only its bands depend on the limit), not planned again (both took
+  // the bunny 0.33 s a time).
+  std::vector<ShellPlan> apart;
+  if (const ShellPlan& first = shells.front(); first.narrowed.empty() && !near.top.empty() &&
+                                               near.refused.empty() &&
+                                               near.banded <= kBandedShare) {
+    apart.push_back(narrowed(std::move(near), curved_among(a, c.among),
+                             banded_refusal(first.banded, first.stands_at, kBandedShare)));
+    if (dropped) shells = {};
+    add_further(mesh, a, less, c, apart);
+  } else {
+    near = {};
+    if (dropped) shells = {};
+    apart = shells_as_set(mesh, a, less, c);
+  }
   const double covered = apart.front().refused.empty() ? area(apart) / banded_area : 0;
   if (covered < kCovered) return dropped ? (apart = {}, shells_as_set(mesh, a, p, c)) : shells;
   // Its notice names the setting the user did not set: say what was weighed instead.

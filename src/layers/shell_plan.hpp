@@ -17,6 +17,7 @@
 
 #include <algorithm>
 #include <limits>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -41,10 +42,11 @@ struct ShellPlan {
   NodeMask region;
   /// s on H's raster, mm (shell_region.hpp); empty: the shell after the whole core.
   FacetedTop slack;
-  ShellLevels levels;   ///< g (shell_levels.hpp)
-  double below = 0;     ///< the bound of s⁻, min(t − a, h/2) − 0.01, mm
-  bool framed = false;  ///< H covers only the patches' surroundings (plan_shell's frame)
-  double banded = 0;    ///< the share of the patches printed in bands (shell_region.hpp)
+  ShellLevels levels;    ///< g (shell_levels.hpp)
+  double below = 0;      ///< the bound of s⁻, min(t − a, h/2) − 0.01, mm
+  bool framed = false;   ///< H covers only the patches' surroundings (plan_shell's frame)
+  double banded = 0;     ///< the share of the patches printed in bands (shell_region.hpp)
+  Vec2 stands_at{0, 0};  ///< where the part first stands above H (shell_region.hpp), mm
   /// What of the patches the shell leaves to the core because an overhang or another surface
   /// lies under it there, and why (empty: none).
   std::string left_out;
@@ -112,6 +114,14 @@ ShellPlan choose_shell(const TriangleMesh& mesh, const Analysis& a, const LayerP
 /// 80 % of its patches' area.
 std::vector<ShellPlan> choose_shells(const TriangleMesh& mesh, const Analysis& a,
                                      const LayerParams& p, int most = 4);
+
+/// The core's boundaries (z_0 = 0 … z_K, mm) of the shells plan_shell makes where the part
+/// stands above some patch that needs curved layers (every such plan has them, its first
+/// layer clear of the shell's stairs), if it does: a facet of such a patch with the part's
+/// surface more than 0.1 mm over its centre. Else none. For a run of the core started before
+/// the shells are planned: the plans say whether they print in pieces on it.
+std::optional<std::vector<double>> region_shells_core(const TriangleMesh& mesh, const Analysis& a,
+                                                      const LayerParams& p);
 
 /// Which shells to choose among.
 struct ShellChoice {

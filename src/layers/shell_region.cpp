@@ -282,16 +282,20 @@ ShellRegion shell_region(const TriangleMesh& mesh, const std::vector<char>& in_p
   // base banded over 69 % took 50m against 47m for four unbanded, 78 % of its top within
   // 0.03 mm against 72 %; the ornament 2h41m against 2h39m, 70 % against 53 %. So bands are
   // allowed by default; shell_max_banded below 1 refuses a shell banded over more of it.
-  if (out.banded > p.shell_max_banded) {
-    char buf[400];
-    std::snprintf(buf, sizeof buf,
-                  "the part stands above the curved top round %.0f %% of it, where the shell "
-                  "would follow it up in bands, each printed apart (near (%.2f, %.2f); "
-                  "shell_max_banded %.2f)",
-                  100 * out.banded, first.x(), first.y(), p.shell_max_banded);
-    out.refused = buf;
-  }
+  out.stands_at = first.head<2>();
+  if (out.banded > p.shell_max_banded)
+    out.refused = banded_refusal(out.banded, out.stands_at, p.shell_max_banded);
   return out;
+}
+
+std::string banded_refusal(double banded, const Vec2& near, double limit) {
+  char buf[400];
+  std::snprintf(buf, sizeof buf,
+                "the part stands above the curved top round %.0f %% of it, where the shell "
+                "would follow it up in bands, each printed apart (near (%.2f, %.2f); "
+                "shell_max_banded %.2f)",
+                100 * banded, near.x(), near.y(), limit);
+  return buf;
 }
 
 std::string notice_at(const char* what, const Vec3& p) {

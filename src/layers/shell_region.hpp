@@ -40,6 +40,10 @@ namespace nonplanar::layers {
 /// "WHAT at (x, y, z)", the place a shell notice names (mm, two decimals).
 std::string notice_at(const char* what, const Vec3& p);
 
+/// Why a shell banded over `banded` (a share) of its patches is refused at shell_max_banded
+/// `limit`, naming `near` (where the part first stands above H, mm).
+std::string banded_refusal(double banded, const Vec2& near, double limit);
+
 struct ShellRegion {
   /// +1 at the nodes of R, −1 elsewhere, on H's raster (its marching-squares contour at 0 is
   /// R's outline); empty when R is the whole raster (nothing of the part stands above H).
@@ -52,6 +56,8 @@ struct ShellRegion {
   /// The share of the patch's nodes that can take no height of g, printed in bands beside what
   /// stands above (more than half: refused).
   double banded = 0;
+  /// Where the part first stands above H (x, y, mm): the place a banded shell's refusal names.
+  Vec2 stands_at{0, 0};
   /// The patches' area outside R, mm² (printed planar by the core).
   double left_out = 0;
   /// Why the core prints some of the patches (left_out > 0), each naming a place: the part

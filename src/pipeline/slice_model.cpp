@@ -524,6 +524,16 @@ Expected<SliceResult> slice_rounds(const TriangleMesh& mesh, const SliceJob& job
     auto a = analyze(mesh, job.analysis, ctx);
     if (!a) return a.error();
     pre.analysis = std::move(*a);
+    // Where the part stands above a curved top, its shells print through PrusaSlicer in pieces
+    // between the layers of one run of the part alone, on boundaries known now: that run goes
+    // on while the stacks and shells are planned (on the bunny 1.3 s), and any other run
+    // stops it.
+    if (pre.engine && job.shells)
+      if (auto core = layers::region_shells_core(mesh, pre.analysis, job.layers)) {
+        EngineRun run;
+        run.layer_tops.assign(core->begin() + 1, core->end());
+        run_engine_ahead(*pre.engine, job.engine, mesh, job.print, std::move(run), ctx);
+      }
     auto fits = fit_for_plan(mesh, pre.analysis, job.fit, job.layers, pre.stacks, &pre.ids, ctx);
     if (!fits) return fits.error();
     pre.fits = std::move(*fits);

@@ -2,8 +2,10 @@
 // shell's core under the shell), and what is left of a layer cut away whole (dropped_layer).
 // s is the parameter along a move, 0 at its start, 1 at its end.
 #include <algorithm>
+#include <atomic>
 #include <cctype>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <optional>
 
@@ -63,9 +65,60 @@ Pieces cut_move(const G& g_at, double len, int n, double slope, std::size_t& sam
 
 }  // namespace
 
-int clip_layer(LayerWork& w, const std::function<double(double, double)>& margin,
-               const std::function<double(const Vec2&, const Vec2&)>& slope_bound,
-               const GcodeRetraction& ret, const LayerPassParams& params, std::size_t& samples,
+namespace {
+
+// Whether clip_layer cuts the move of line `it`: an extrusion not left `untouched`.
+bool cut_here(const LayerWork& w, const GcodeLine& it,
+              const std::function<bool(const GcodeMove&)>& untouched) {
+  if (it.kind != GcodeLine::Kind::move) return false;
+  const GcodeMove& m = w.moves[static_cast<std::size_t>(it.move)];
+  return m.extruding() && !(untouched && untouched(m));
+}
+
+}  // namespace
+
+LayerCuts cut_layer(const LayerWork& w, const std::function<double(double, double)>& margin,
+                    const std::function<double(const Vec2&, const Vec2&)>& slope_bound,
+                    const LayerPassParams& params, std::atomic<std::size_t>& looked,
+                    const std::function<bool(const GcodeMove&)>& untouched) {
+  LayerCuts out;
+  for (const GcodeLine& it : w.lines) {
+    if (!cut_here(w, it, untouched)) continue;
+    const GcodeMove& m = w.moves[static_cast<std::size_t>(it.move)];
+    auto g = [&](double s) {
+      const Vec3 p = m.from + s * (m.to - m.from);
+      return margin(p.x(), p.y());
+    };
+    const double len = (m.to - m.from).head<2>().norm();
+    const int n = std::max(1, static_cast<int>(std::ceil(len / params.clip_step)));
+    out.steps.push_back(static_cast<std::uint32_t>(n));
+    if (looked.load(std::memory_order_relaxed) + static_cast<std::size_t>(n) >
+        params.most_clip_samples) {
+      out.looks.push_back(0), out.complete = false;
+      return out;
+    }
+    // On the wing's core 7 in 10 moves lie wholly on one side, clear of the cut, and a long
+    // infill line across it is looked at step by step only near it: the core's mapping took
+    // 0.61 s, now 0.10 s.
+    const double slope = slope_bound ? slope_bound(m.from.head<2>().cwiseMin(m.to.head<2>()),
+                                                   m.from.head<2>().cwiseMax(m.to.head<2>()))
+                                     : std::numeric_limits<double>::infinity();
+    std::size_t samples = 0;
+    Pieces pieces = cut_move(g, len, n, slope, samples);
+    out.looks.push_back(static_cast<std::uint32_t>(std::min<std::size_t>(samples, UINT32_MAX)));
+    out.cuts.insert(out.cuts.end(), pieces.cuts.begin(), pieces.cuts.end());
+    out.kept.insert(out.kept.end(), pieces.kept.begin(), pieces.kept.end());
+    out.begin.push_back(static_cast<std::uint32_t>(out.cuts.size()));
+    if (looked.fetch_add(samples, std::memory_order_relaxed) + samples > params.most_clip_samples) {
+      out.complete = false;
+      return out;
+    }
+  }
+  return out;
+}
+
+int clip_layer(LayerWork& w, const LayerCuts& cuts, const GcodeRetraction& ret,
+               const LayerPassParams& params, std::size_t& samples,
                const std::function<bool(const GcodeMove&)>& untouched) {
   std::vector<GcodeLine> out;
   out.reserve(w.lines.size());
@@ -76,43 +129,32 @@ int clip_layer(LayerWork& w, const std::function<double(double, double)>& margin
   auto settle = [&] {
     if (owed) out.push_back(w.add(*owed)), owed.reset();
   };
+  std::size_t k = 0;  // the cut move's index in `cuts`
   for (const GcodeLine& it : w.lines) {
-    if (it.kind != GcodeLine::Kind::move ||
-        !w.moves[static_cast<std::size_t>(it.move)].extruding() ||
-        (untouched && untouched(w.moves[static_cast<std::size_t>(it.move)]))) {
+    if (!cut_here(w, it, untouched)) {
       settle();
       out.push_back(it);
       continue;
     }
     const GcodeMove m = w.moves[static_cast<std::size_t>(it.move)];
-    auto at = [&](double s) { return Vec3(m.from + s * (m.to - m.from)); };
-    auto g = [&](double s) {
-      const Vec3 p = at(s);
-      return margin(p.x(), p.y());
-    };
-    const double len = (m.to - m.from).head<2>().norm();
-    const int n = std::max(1, static_cast<int>(std::ceil(len / params.clip_step)));
-    if (samples + static_cast<std::size_t>(n) > params.most_clip_samples) return m.line;
-    // On the wing's core 7 in 10 moves lie wholly on one side, clear of the cut, and a long
-    // infill line across it is looked at step by step only near it: the core's mapping took
-    // 0.61 s, now 0.10 s.
-    const double slope = slope_bound ? slope_bound(m.from.head<2>().cwiseMin(m.to.head<2>()),
-                                                   m.from.head<2>().cwiseMax(m.to.head<2>()))
-                                     : std::numeric_limits<double>::infinity();
-    const Pieces pieces = cut_move(g, len, n, slope, samples);
-    if (samples > params.most_clip_samples) return m.line;
-    const std::vector<double>& cuts = pieces.cuts;
-    if (cuts.size() == 2 && pieces.kept[0]) {
+    // The count as the moves were cut one by one: the line it passes the limit on.
+    if (k >= cuts.steps.size() || samples + cuts.steps[k] > params.most_clip_samples) return m.line;
+    samples += cuts.looks[k];
+    if (samples > params.most_clip_samples || k + 1 >= cuts.begin.size()) return m.line;
+    const std::size_t b = cuts.begin[k], e = cuts.begin[k + 1], kept0 = b - k;
+    ++k;
+    if (e - b == 2 && cuts.kept[kept0]) {
       out.push_back(it);
       continue;
     }
-    for (std::size_t k = 0; k + 1 < cuts.size(); ++k) {
+    auto at = [&](double s) { return Vec3(m.from + s * (m.to - m.from)); };
+    for (std::size_t q = b; q + 1 < e; ++q) {
       GcodeMove piece = m;
-      piece.from = at(cuts[k]), piece.to = at(cuts[k + 1]);
-      piece.f = k == 0 ? m.f : kNoValue;
-      if (pieces.kept[k]) {
+      piece.from = at(cuts.cuts[q]), piece.to = at(cuts.cuts[q + 1]);
+      piece.f = q == b ? m.f : kNoValue;
+      if (cuts.kept[kept0 + (q - b)]) {
         if (owed) settle(), piece.f = m.feed;  // after the give-back's feed rate
-        piece.de = m.de * (cuts[k + 1] - cuts[k]);
+        piece.de = m.de * (cuts.cuts[q + 1] - cuts.cuts[q]);
         out.push_back(w.add(piece));
         continue;
       }
@@ -133,6 +175,15 @@ int clip_layer(LayerWork& w, const std::function<double(double, double)>& margin
   settle();
   w.lines = std::move(out);
   return 0;
+}
+
+int clip_layer(LayerWork& w, const std::function<double(double, double)>& margin,
+               const std::function<double(const Vec2&, const Vec2&)>& slope_bound,
+               const GcodeRetraction& ret, const LayerPassParams& params, std::size_t& samples,
+               const std::function<bool(const GcodeMove&)>& untouched) {
+  std::atomic<std::size_t> looked{samples};
+  const LayerCuts cuts = cut_layer(w, margin, slope_bound, params, looked, untouched);
+  return clip_layer(w, cuts, ret, params, samples, untouched);
 }
 
 void dropped_layer(const std::vector<GcodeLine>& lines, ProgramLayer& out) {

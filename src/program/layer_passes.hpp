@@ -2,7 +2,9 @@
 // route that maps G-code (another slicer's file, a shell's core and slab, a post-processed file).
 #pragma once
 
+#include <atomic>
 #include <cstddef>
+#include <cstdint>
 #include <functional>
 #include <vector>
 
@@ -88,6 +90,30 @@ void order_top_skins(LayerWork& layer, const LayerPassParams& p);
 int clip_layer(LayerWork& layer, const std::function<double(double x, double y)>& margin,
                const std::function<double(const Vec2& lo, const Vec2& hi)>& slope_bound,
                const GcodeRetraction& ret, const LayerPassParams& p, std::size_t& samples,
+               const std::function<bool(const GcodeMove&)>& untouched = {});
+
+/// clip_layer in two halves, so that layers can be cut side by side and put together in
+/// order: where each extrusion it cuts is cut (cut_layer; reads the layer only), then the
+/// layer made of the pieces (clip_layer with the cuts). For the k-th such move of the layer
+/// (in order): `steps[k]` the steps it is looked at on, `looks[k]` the margins looked up,
+/// its pieces' cut parameters cuts[begin[k] … begin[k + 1]] (0 … 1) and whether each is kept
+/// (kept[begin[k] − k …]). `complete` is false when cut_layer stopped: `looked`, shared by
+/// the layers cut side by side, went past p.most_clip_samples.
+struct LayerCuts {
+  std::vector<std::uint32_t> begin{0};
+  std::vector<double> cuts;
+  std::vector<char> kept;
+  std::vector<std::uint32_t> steps, looks;
+  bool complete = true;
+};
+LayerCuts cut_layer(const LayerWork& layer, const std::function<double(double x, double y)>& margin,
+                    const std::function<double(const Vec2& lo, const Vec2& hi)>& slope_bound,
+                    const LayerPassParams& p, std::atomic<std::size_t>& looked,
+                    const std::function<bool(const GcodeMove&)>& untouched = {});
+/// The layer of `cuts` (cut_layer's of this layer, complete): as clip_layer, `samples` and
+/// the line returned past p.most_clip_samples as it counts them.
+int clip_layer(LayerWork& layer, const LayerCuts& cuts, const GcodeRetraction& ret,
+               const LayerPassParams& p, std::size_t& samples,
                const std::function<bool(const GcodeMove&)>& untouched = {});
 
 /// A layer the clip left nothing of, as steps (into `out`): only what it tells the printer

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <map>
 
@@ -127,16 +128,16 @@ class Zigzag final : public LayerClip {
   double slope_bound(const Vec2& lo, const Vec2& hi, double z) const override {
     return tell_ ? std::hypot(1.0, 0.05) : LayerClip::slope_bound(lo, hi, z);
   }
-  mutable long looked = 0;
+  mutable std::atomic<long> looked{0};  // (layers are cut side by side)
 
  private:
   bool tell_;
 };
 
-TEST(MapForeignGcode, AClipsSlopeBoundSkipsStepsNotCuts) {
-  // Infill lines across the zigzag, 30 mm long, 0.45 mm apart, on two layers.
+// Infill lines across the zigzag, 30 mm long, 0.45 mm apart, on `layers` layers.
+std::string zigzag_infill(int layers) {
   std::string g = "M83\n";
-  for (int layer = 0; layer < 2; ++layer) {
+  for (int layer = 0; layer < layers; ++layer) {
     const double z = 0.2 * (layer + 1);
     g += ";LAYER_CHANGE\n;Z:" + std::to_string(z) + "\n;HEIGHT:0.2\nG1 Z" + std::to_string(z) +
          " F600\nG1 X0 Y0 F6000\n;TYPE:Internal infill\n";
@@ -146,6 +147,11 @@ TEST(MapForeignGcode, AClipsSlopeBoundSkipsStepsNotCuts) {
       g += "G1 X" + std::to_string(k % 2 ? 0 : 30) + " Y" + std::to_string(y + 0.45) + " E0.02\n";
     }
   }
+  return g;
+}
+
+TEST(MapForeignGcode, AClipsSlopeBoundSkipsStepsNotCuts) {
+  const std::string g = zigzag_infill(2);
   const auto field = planar_field({});
   auto run = [&](const Zigzag& clip) {
     ForeignMapOptions o;
@@ -159,6 +165,40 @@ TEST(MapForeignGcode, AClipsSlopeBoundSkipsStepsNotCuts) {
   EXPECT_TRUE(a == b);                                   // (not EXPECT_EQ: 20 kB of text)
   EXPECT_GT(std::count(a.begin(), a.end(), '\n'), 200);  // cut many times over
   EXPECT_LT(bounded.looked * 2, every_step.looked) << bounded.looked << " " << every_step.looked;
+}
+
+// The clip's limit on the margins looked up (most_clip_samples) stops the map at the line where
+// the count passes it, as when the layers were cut one by one: cut side by side, 32 layers at
+// once, it stops at the same line as one layer at a time, wherever in the file the limit falls.
+// The margins looked up side by side stay within twice the limit (the layers stop once their
+// shared count passes it; the layer it stopped in is cut again in turn, to find the line).
+TEST(MapForeignGcode, TheClipsLimitStopsAtTheLineTheCountPassesIt) {
+  const std::string g = zigzag_infill(12);
+  const auto field = planar_field({});
+  auto run = [&](const Zigzag& clip, std::size_t most, std::size_t at_once) {
+    MapBackParams mp;
+    mp.passes.most_clip_samples = most;
+    ForeignMapOptions o;
+    o.clip = &clip;
+    o.layers_at_once = at_once;
+    auto r = map_foreign_gcode(g, *field, mp, {}, o);
+    return r ? std::string("ok") : r.error().message;
+  };
+  const Zigzag all(true);
+  ASSERT_EQ(run(all, 50'000'000, 32), "ok");
+  const auto total = static_cast<std::size_t>(all.looked.load());
+  std::string last;
+  for (const double share : {0.1, 0.45, 0.8, 0.999}) {
+    const auto most = static_cast<std::size_t>(share * static_cast<double>(total));
+    const Zigzag side_by_side(true), in_turn(true);
+    const std::string a = run(side_by_side, most, 32), b = run(in_turn, most, 1);
+    EXPECT_EQ(a, b);
+    EXPECT_NE(a.find("more than " + std::to_string(most) + " clip samples"), std::string::npos)
+        << a;
+    EXPECT_NE(a, last);  // a later line each time
+    last = a;
+    EXPECT_LT(side_by_side.looked, 2 * static_cast<long>(most));
+  }
 }
 
 }  // namespace

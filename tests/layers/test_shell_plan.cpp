@@ -255,5 +255,53 @@ TEST(ShellPlan, RefusesAShellMostlyPrintedInBands) {
   EXPECT_NEAR(chosen.front().banded, 0.69, 0.01);
 }
 
+// The core's boundaries are foreseen from the analysis where the part stands above a curved
+// top (a tower on the rib), as its shells then plan them, so that an engine can slice the core
+// while they are planned; nothing is foreseen where nothing stands above it (the rib alone).
+TEST(ShellPlan, ForeseesTheCoreOfShellsThePartStandsAbove) {
+  const TriangleMesh rib = test::rib();
+  const Analysis a = *analyze(rib, {}, {});
+  EXPECT_FALSE(layers::region_shells_core(rib, a, {}));
+  TriangleMesh tower = test::rib();
+  test::append(tower, test::box({45, 3, 0}, {55, 9, 20}));
+  const Analysis b = *analyze(tower, {}, {});
+  const auto core = layers::region_shells_core(tower, b, {});
+  ASSERT_TRUE(core);
+  const std::vector<layers::ShellPlan> plans = layers::choose_shells(tower, b, {});
+  ASSERT_TRUE(plans.front().refused.empty()) << plans.front().refused;
+  EXPECT_FALSE(plans.front().region.empty());
+  EXPECT_EQ(plans.front().core, *core);
+  EXPECT_NEAR(core->back(), 20.0, 0.2);  // up to the tower's top
+}
+
+// choose_shells weighs the bunny's shell, banded over 52 % of its patches, against the shells
+// apart at shell_max_banded 0.5, and takes those (they follow 86 % of its area). Their first is
+// the group near the largest patch that choose_first planned beside the banded shell, taken as
+// planned there rather than planned again: as choose_shell plans it at 0.5, bands, slack and
+// all, its notice naming what was weighed instead of the setting.
+TEST(ShellPlan, TheShellsApartBeginWithTheGroupPlannedBesideTheBandedOne) {
+  const auto dir = test::shared_models();
+  if (dir.empty()) GTEST_SKIP() << "../shared/models not present";
+  auto m = load_mesh(dir / "np_stanford_bunny_closed_compas.stl", {}, {});
+  ASSERT_TRUE(m);
+  const Analysis a = *analyze(m->mesh, {}, {});
+  const std::vector<layers::ShellPlan> chosen = layers::choose_shells(m->mesh, a, {});
+  ASSERT_EQ(chosen.size(), 4u);
+  LayerParams half;
+  half.shell_max_banded = 0.5;
+  const layers::ShellPlan first = layers::choose_shell(m->mesh, a, half);
+  ASSERT_TRUE(first.refused.empty()) << first.refused;
+  EXPECT_EQ(chosen[0].patches, first.patches);
+  EXPECT_EQ(chosen[0].core, first.core);
+  EXPECT_EQ(chosen[0].region.in, first.region.in);
+  EXPECT_EQ(chosen[0].slack.h, first.slack.h);
+  EXPECT_EQ(chosen[0].banded, first.banded);
+  const auto k = first.narrowed.find("shell_max_banded 0.50");
+  ASSERT_NE(k, std::string::npos) << first.narrowed;
+  EXPECT_EQ(chosen[0].narrowed.substr(0, k), first.narrowed.substr(0, k));
+  EXPECT_NE(chosen[0].narrowed.find("shells apart follow 86 % of its area"), std::string::npos)
+      << chosen[0].narrowed;
+}
+
 }  // namespace
 }  // namespace nonplanar

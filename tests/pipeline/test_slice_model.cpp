@@ -10,6 +10,8 @@
 #include <thread>
 #include <vector>
 
+#include "layers/shell_plan.hpp"
+#include "nonplanar/analysis.hpp"
 #include "nonplanar/check.hpp"
 #include "nonplanar/gcode.hpp"
 #include "nonplanar/pipeline.hpp"
@@ -89,6 +91,50 @@ TEST(ShellBeforeStacks, ThroughAnEngineAShellThePartStandsAbovePrintsInPieces) {
   EXPECT_GT(builtin_f.within_share, 0.95);
   EXPECT_GT(engine_f.within_share, builtin_f.within_share - 0.02);
   EXPECT_EQ(engine_f.collisions, 0u);
+}
+
+// A tower standing on the rib's curved top: the shell prints in pieces through PrusaSlicer,
+// and the run of the part on the core's boundaries, foreseen once the part is analysed
+// (layers::region_shells_core), is handed to the engine started early before the shells are
+// planned: the engine that prints is the first started (a spare started beside it, for a
+// route that would not want that run, is stopped unused), and its file is what a run started
+// once the shells are planned prints (the built-in engine's pieces, the same core).
+TEST(ShellBeforeStacks, ThroughAnEngineTheCoreRunsWhileTheShellsArePlanned) {
+  if (!have_prusaslicer()) GTEST_SKIP() << "prusa-slicer not installed";
+  const fs::path dir = test::temp_dir("core_ahead");
+  const fs::path log = dir / "runs.log", exe = dir / "prusa-slicer";
+  {
+    std::ofstream sh(exe);
+    sh << "#!/bin/sh\necho \"start $$\" >> '" << log.string() << "'\nprusa-slicer \"$@\"\n"
+       << "rc=$?\necho \"done $$\" >> '" << log.string() << "'\nexit $rc\n";
+  }
+  fs::permissions(exe, fs::perms::owner_all);
+  PrintConfig c;
+  TriangleMesh part = test::rib();
+  test::append(part, test::box({45, 3, 0}, {55, 9, 20}));
+  const TriangleMesh mesh = test::placed(part, c);
+  const Analysis a = *analyze(mesh, {}, {});
+  SliceJob job = make_job(c);
+  const auto core = layers::region_shells_core(mesh, a, job.layers);
+  ASSERT_TRUE(core);
+  job.engine.engine = Engine::prusaslicer;
+  job.engine.path = exe.string();
+  auto r = slice_model(mesh, job, {});
+  ASSERT_TRUE(r) << r.error().message;
+  EXPECT_EQ(r->collisions, 0u);
+  EXPECT_NE(r->gcode.find("; nonplanar: curved paths printed between the engine's layers"),
+            std::string::npos);
+  std::ifstream runs(log);
+  std::vector<std::string> lines;
+  for (std::string l; std::getline(runs, l);) lines.push_back(l);
+  ASSERT_EQ(lines.size(), 3u);  // two started, one finished: the first
+  EXPECT_EQ(lines[0].rfind("start ", 0), 0u);
+  EXPECT_EQ(lines[1].rfind("start ", 0), 0u);
+  EXPECT_EQ(lines[2], "done " + lines[0].substr(6));
+  // The core's layers are the ones foreseen (each ;Z: of the core on one of them).
+  const std::vector<layers::ShellPlan> plans = layers::choose_shells(mesh, a, job.layers);
+  ASSERT_FALSE(plans.front().region.empty());
+  EXPECT_EQ(plans.front().core, *core);
 }
 
 // A caller that wants only the G-code (the CLI) has the paths go once it is written: the
