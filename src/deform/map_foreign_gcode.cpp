@@ -417,7 +417,7 @@ std::optional<Error> write_piece(InOrder& o, const Context& ctx) {
   // layer cut short (the layers together went past the limit) is cut again in turn, which
   // finds the line the limit is passed on.
   std::vector<program::LayerCuts> cuts(o.options.clip ? spans.size() : 0);
-  if (o.options.clip) {
+  if (!cuts.empty()) {
     std::atomic<std::size_t> looked{o.clip_samples};
     core::parallel_for(std::size_t(0), spans.size(), [&](std::size_t k) {
       if (layer_cover(o, spans[k]) == LayerClip::Cover::some)

@@ -82,6 +82,7 @@ LayerCuts cut_layer(const LayerWork& w, const std::function<double(double, doubl
                     const LayerPassParams& params, std::atomic<std::size_t>& looked,
                     const std::function<bool(const GcodeMove&)>& untouched) {
   LayerCuts out;
+  out.complete = true;
   for (const GcodeLine& it : w.lines) {
     if (!cut_here(w, it, untouched)) continue;
     const GcodeMove& m = w.moves[static_cast<std::size_t>(it.move)];

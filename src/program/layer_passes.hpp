@@ -97,14 +97,15 @@ int clip_layer(LayerWork& layer, const std::function<double(double x, double y)>
 /// layer made of the pieces (clip_layer with the cuts). For the k-th such move of the layer
 /// (in order): `steps[k]` the steps it is looked at on, `looks[k]` the margins looked up,
 /// its pieces' cut parameters cuts[begin[k] … begin[k + 1]] (0 … 1) and whether each is kept
-/// (kept[begin[k] − k …]). `complete` is false when cut_layer stopped: `looked`, shared by
-/// the layers cut side by side, went past p.most_clip_samples.
+/// (kept[begin[k] − k …]). `complete`: cut_layer cut every move (not when it stopped because
+/// `looked`, shared by the layers cut side by side, went past p.most_clip_samples, nor for a
+/// LayerCuts it did not make).
 struct LayerCuts {
   std::vector<std::uint32_t> begin{0};
   std::vector<double> cuts;
   std::vector<char> kept;
   std::vector<std::uint32_t> steps, looks;
-  bool complete = true;
+  bool complete = false;
 };
 LayerCuts cut_layer(const LayerWork& layer, const std::function<double(double x, double y)>& margin,
                     const std::function<double(const Vec2& lo, const Vec2& hi)>& slope_bound,
