@@ -548,6 +548,10 @@ void run_engine_ahead(EarlyEngine& early, const EngineParams& e, const TriangleM
   });
 }
 
+bool engine_ahead(const EarlyEngine* early) {
+  return early && early->ahead;
+}
+
 namespace {
 
 // The G-code of the run handed over ahead, when this is that run (else that run is stopped,

@@ -92,6 +92,9 @@ Expected<std::string> run_engine(const EngineParams& e, const TriangleMesh& mesh
 void run_engine_ahead(EarlyEngine& early, const EngineParams& e, const TriangleMesh& mesh,
                       const PrintConfig& c, EngineRun run, const Context& ctx);
 
+/// Whether `early` (null: no) has a run handed over ahead, neither taken nor stopped yet.
+bool engine_ahead(const EarlyEngine* early);
+
 /// For a signal handler (async-signal-safe): SIGKILL the running engines' process groups (an
 /// early one may wait); each run_engine() then returns and
 /// removes its folder. True if one ran.

@@ -96,9 +96,10 @@ TEST(ShellBeforeStacks, ThroughAnEngineAShellThePartStandsAbovePrintsInPieces) {
 // A tower standing on the rib's curved top: the shell prints in pieces through PrusaSlicer,
 // and the run of the part on the core's boundaries, foreseen once the part is analysed
 // (layers::region_shells_core), is handed to the engine started early before the shells are
-// planned: the engine that prints is the first started (a spare started beside it, for a
-// route that would not want that run, is stopped unused), and its file is what a run started
-// once the shells are planned prints (the built-in engine's pieces, the same core).
+// planned (they are planned at idle priority meanwhile): the engine that prints is the first
+// started (a spare started beside it, for a route that would not want that run, is stopped
+// unused), and its file is what a run started once the shells are planned prints (the
+// built-in engine's pieces, the same core).
 TEST(ShellBeforeStacks, ThroughAnEngineTheCoreRunsWhileTheShellsArePlanned) {
   if (!have_prusaslicer()) GTEST_SKIP() << "prusa-slicer not installed";
   const fs::path dir = test::temp_dir("core_ahead");
@@ -119,8 +120,24 @@ TEST(ShellBeforeStacks, ThroughAnEngineTheCoreRunsWhileTheShellsArePlanned) {
   ASSERT_TRUE(core);
   job.engine.engine = Engine::prusaslicer;
   job.engine.path = exe.string();
-  auto r = slice_model(mesh, job, {});
+  // The plan, made on a thread of idle priority meanwhile, reports on the caller's thread.
+  std::vector<std::string> stages;
+  bool other_thread = false;
+  const auto caller = std::this_thread::get_id();
+  Context ctx;
+  ctx.on_progress = [&](std::string_view stage, double) {
+    if (stages.empty() || stages.back() != stage) stages.emplace_back(stage);
+    other_thread |= std::this_thread::get_id() != caller;
+  };
+  auto r = slice_model(mesh, job, ctx);
   ASSERT_TRUE(r) << r.error().message;
+  EXPECT_FALSE(other_thread);
+  const auto at = [&](const char* s) {
+    return std::find(stages.begin(), stages.end(), s) - stages.begin();
+  };
+  ASSERT_LT(at("engine"), static_cast<long>(stages.size()));
+  EXPECT_LT(at("fit"), at("shell"));
+  EXPECT_LT(at("shell"), at("engine"));
   EXPECT_EQ(r->collisions, 0u);
   EXPECT_NE(r->gcode.find("; nonplanar: curved paths printed between the engine's layers"),
             std::string::npos);
