@@ -116,10 +116,12 @@ std::vector<ShellPlan> choose_shells(const TriangleMesh& mesh, const Analysis& a
                                      const LayerParams& p, int most = 4);
 
 /// The core's boundaries (z_0 = 0 … z_K, mm) of the shells plan_shell makes where the part
-/// stands above some patch that needs curved layers (every such plan has them, its first
-/// layer clear of the shell's stairs), if it does: a facet of such a patch with the part's
-/// surface more than 0.1 mm over its centre. Else none. For a run of the core started before
-/// the shells are planned: the plans say whether they print in pieces on it.
+/// stands above some patch that needs curved layers (up to the part's top, landing on the flat
+/// patches, the first layer chosen for H as low as those patches' lowest point), if it does: a
+/// facet more than 0.1 mm over the centre of such a patch's facet, or a facet's corner more
+/// than 0.1 mm over one. Else none (and none is foreseen where the part stands only beside
+/// them, over H's pad: a wall round a curved floor). For a run of the core started before the
+/// shells are planned: their plans say whether they print in pieces on it.
 std::optional<std::vector<double>> region_shells_core(const TriangleMesh& mesh, const Analysis& a,
                                                       const LayerParams& p);
 
