@@ -25,6 +25,25 @@ using test::have_prusaslicer;
 
 namespace fs = std::filesystem;
 
+// The stages a slice reports, each once in a row, and whether any came from another thread
+// than the one that made the context.
+struct Stages {
+  std::vector<std::string> stages;
+  bool other_thread = false;
+  std::thread::id caller = std::this_thread::get_id();
+  Context context() {
+    Context ctx;
+    ctx.on_progress = [this](std::string_view stage, double) {
+      if (stages.empty() || stages.back() != stage) stages.emplace_back(stage);
+      other_thread |= std::this_thread::get_id() != caller;
+    };
+    return ctx;
+  }
+  long at(const char* stage) const {
+    return std::find(stages.begin(), stages.end(), stage) - stages.begin();
+  }
+};
+
 // The rib and the small domed tower through PrusaSlicer: the tower's stack covers too little,
 // so a shell over both is planned first. The tower stands above the rib, so the shell prints
 // in pieces between the engine's core layers (shell_pieces_with_engine), as the built-in
@@ -45,14 +64,8 @@ TEST(ShellBeforeStacks, ThroughAnEngineAShellThePartStandsAbovePrintsInPieces) {
   SliceJob job = make_job(c);
   job.engine.engine = Engine::prusaslicer;
   job.engine.path = exe.string();
-  std::vector<std::string> stages;
-  bool other_thread = false;
-  const auto caller = std::this_thread::get_id();
-  Context ctx;
-  ctx.on_progress = [&](std::string_view stage, double) {
-    if (stages.empty() || stages.back() != stage) stages.emplace_back(stage);
-    other_thread |= std::this_thread::get_id() != caller;
-  };
+  Stages progress;
+  const Context ctx = progress.context();
   auto r = slice_model(mesh, job, ctx);
   ASSERT_TRUE(r) << r.error().message;
   EXPECT_TRUE(r->plan.stacks.empty());
@@ -63,13 +76,10 @@ TEST(ShellBeforeStacks, ThroughAnEngineAShellThePartStandsAbovePrintsInPieces) {
   std::ifstream starts(log);
   const std::string text((std::istreambuf_iterator<char>(starts)), {});
   EXPECT_EQ(text, "start\n");
-  EXPECT_FALSE(other_thread);
-  const auto at = [&](const char* s) {
-    return std::find(stages.begin(), stages.end(), s) - stages.begin();
-  };
-  ASSERT_LT(at("engine"), static_cast<long>(stages.size()));
-  EXPECT_LT(at("shell"), at("engine"));
-  EXPECT_LT(at("engine"), at("core"));
+  EXPECT_FALSE(progress.other_thread);
+  ASSERT_LT(progress.at("engine"), static_cast<long>(progress.stages.size()));
+  EXPECT_LT(progress.at("shell"), progress.at("engine"));
+  EXPECT_LT(progress.at("engine"), progress.at("core"));
 
   // The built-in engine's print of the same shell, and both as `check` measures them: the
   // pieces are the same, so the top is as close (0.994 both, through PrusaSlicer 2.5).
@@ -98,8 +108,7 @@ TEST(ShellBeforeStacks, ThroughAnEngineAShellThePartStandsAbovePrintsInPieces) {
 // (layers::region_shells_core), is handed to the engine started early before the shells are
 // planned (they are planned at idle priority meanwhile): the engine that prints is the first
 // started (a spare started beside it, for a route that would not want that run, is stopped
-// unused), and its file is what a run started once the shells are planned prints (the
-// built-in engine's pieces, the same core).
+// unused), on the boundaries the shells' plan gives the core.
 TEST(ShellBeforeStacks, ThroughAnEngineTheCoreRunsWhileTheShellsArePlanned) {
   if (!have_prusaslicer()) GTEST_SKIP() << "prusa-slicer not installed";
   const fs::path dir = test::temp_dir("core_ahead");
@@ -121,23 +130,14 @@ TEST(ShellBeforeStacks, ThroughAnEngineTheCoreRunsWhileTheShellsArePlanned) {
   job.engine.engine = Engine::prusaslicer;
   job.engine.path = exe.string();
   // The plan, made on a thread of idle priority meanwhile, reports on the caller's thread.
-  std::vector<std::string> stages;
-  bool other_thread = false;
-  const auto caller = std::this_thread::get_id();
-  Context ctx;
-  ctx.on_progress = [&](std::string_view stage, double) {
-    if (stages.empty() || stages.back() != stage) stages.emplace_back(stage);
-    other_thread |= std::this_thread::get_id() != caller;
-  };
+  Stages progress;
+  const Context ctx = progress.context();
   auto r = slice_model(mesh, job, ctx);
   ASSERT_TRUE(r) << r.error().message;
-  EXPECT_FALSE(other_thread);
-  const auto at = [&](const char* s) {
-    return std::find(stages.begin(), stages.end(), s) - stages.begin();
-  };
-  ASSERT_LT(at("engine"), static_cast<long>(stages.size()));
-  EXPECT_LT(at("fit"), at("shell"));
-  EXPECT_LT(at("shell"), at("engine"));
+  EXPECT_FALSE(progress.other_thread);
+  ASSERT_LT(progress.at("engine"), static_cast<long>(progress.stages.size()));
+  EXPECT_LT(progress.at("fit"), progress.at("shell"));
+  EXPECT_LT(progress.at("shell"), progress.at("engine"));
   EXPECT_EQ(r->collisions, 0u);
   EXPECT_NE(r->gcode.find("; nonplanar: curved paths printed between the engine's layers"),
             std::string::npos);
@@ -148,7 +148,7 @@ TEST(ShellBeforeStacks, ThroughAnEngineTheCoreRunsWhileTheShellsArePlanned) {
   EXPECT_EQ(lines[0].rfind("start ", 0), 0u);
   EXPECT_EQ(lines[1].rfind("start ", 0), 0u);
   EXPECT_EQ(lines[2], "done " + lines[0].substr(6));
-  // The core's layers are the ones foreseen (each ;Z: of the core on one of them).
+  // The core's boundaries are the ones foreseen.
   const std::vector<layers::ShellPlan> plans = layers::choose_shells(mesh, a, job.layers);
   ASSERT_FALSE(plans.front().region.empty());
   EXPECT_EQ(plans.front().core, *core);
