@@ -7,17 +7,14 @@
 #include <vector>
 
 #include "core/huge_pages.hpp"
+#include "io/hash_mix.hpp"
 #include "io/repair.hpp"
 
 namespace nonplanar::io {
 namespace {
 
-std::uint64_t mix(std::uint64_t h) {  // splitmix64 finaliser
-  h ^= h >> 30;
-  h *= 0xbf58476d1ce4e5b9ULL;
-  h ^= h >> 27;
-  h *= 0x94d049bb133111ebULL;
-  return h ^ (h >> 31);
+std::uint64_t mix(std::uint64_t h) {
+  return mix64(h);
 }
 
 std::uint64_t hash_point(const Vec3& p) {
