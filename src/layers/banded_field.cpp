@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <optional>
 
 #include "nurbs/bspline_basis.hpp"
 
@@ -229,6 +230,30 @@ class BandedField::Column {
     return kept_[k][i];
   }
   bool planar() const { return n_ == 0 && !field_; }
+  /// The heights where T's pieces meet, into `z` (unsorted): h₁, and per band c, S_N … S_0 and
+  /// S_0 + L_rec. Between two neighbours T is linear in z (T_p and every δ_b are), except
+  /// where a band's δ fades over (S_0, S_0 + L_rec): those spans go to `fading`. False where
+  /// that does not hold or is not worth it: more bands than kept, a band of kKept layers or
+  /// more, surfaces not strictly decreasing down to c (a zero-thick layer is a step of T, as is
+  /// S_N under c by more than rounding), or no fade (a step at S_0).
+  bool pieces(std::vector<double>& z, std::vector<std::pair<double, double>>& fading) const {
+    if (field_) return false;
+    z.push_back(pl_.h1);
+    for (int k = 0; k < n_; ++k) {
+      const Band& b = *band_[k];
+      if (b.N >= kKept || !(b.fade > 0)) return false;
+      z.push_back(b.c);
+      for (int i = b.N; i >= 0; --i) {
+        const double S = surface(k, i);
+        // S_N is c up to rounding (1e-15 under it on the sine roof): T steps by as little there.
+        if (i == b.N ? !(S >= b.c - 1e-9) : !(S > z.back())) return false;
+        z.push_back(S);
+      }
+      z.push_back(surface(k, 0) + b.fade);
+      fading.emplace_back(surface(k, 0), z.back());
+    }
+    return true;
+  }
   /// The one band with β = 1 here when no other band reaches, else null.
   const Band* only(const Band::Basis** basis) const {
     if (field_ || n_ != 1 || beta_[0] < 1 - 1e-12) return nullptr;
@@ -263,6 +288,35 @@ double BandedField::T(double x, double y, double z) const {
 
 namespace {
 constexpr double kNoHint = std::numeric_limits<double>::quiet_NaN();  ///< z_at: no root below
+
+// T over a piece of a column where it is a cubic in z (a band's δ fades by a smoothstep, the
+// other terms are linear there): through T at the piece's ends and thirds, in s = (z − za)/w
+// with w a third of the piece, by Newton's forward differences (d1, d2, d3 of f0 = T(za)).
+struct CubicPiece {
+  double za = 0, w = 0, f0 = 0, c1 = 0, c2 = 0, c3 = 0;  ///< T = f0 + c1 s + c2 s² + c3 s³
+  CubicPiece(double a, double b, const double f[4]) : za(a), w((b - a) / 3), f0(f[0]) {
+    const double d1 = f[1] - f[0], d2 = f[2] - 2 * f[1] + f[0];
+    const double d3 = f[3] - 3 * f[2] + 3 * f[1] - f[0];
+    c1 = d1 - d2 / 2 + d3 / 3, c2 = d2 / 2 - d3 / 2, c3 = d3 / 6;
+  }
+  double T(double s) const { return f0 + s * (c1 + s * (c2 + s * c3)); }
+  double dT(double s) const { return c1 + s * (2 * c2 + 3 * s * c3); }
+  /// z where T = t, T(za) <= t <= T(za + 3w): Newton kept inside a shrinking bracket, to tol.
+  double root(double t, double tol) const {
+    double lo = 0, hi = 3, s = 1.5;
+    for (int it = 0; it < 100; ++it) {
+      const double f = T(s) - t, d = dT(s);
+      if (f == 0) break;  // else s would close the bracket on itself, and bisect on and on
+      (f < 0 ? lo : hi) = s;
+      double next = d > 0 ? s - f / d : 0.5 * (lo + hi);
+      if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
+      const bool done = std::abs(next - s) * w < 1e-3 * tol || hi - lo < 1e-15;
+      s = next;
+      if (done) break;
+    }
+    return za + s * w;
+  }
+};
 }  // namespace
 
 double BandedField::z_at(double x, double y, double t) const {
@@ -297,6 +351,11 @@ double BandedField::z_at(const Column& col, double t, double lo_hint, double tol
   double flo = col.T(lo) - t, fhi = col.T(hi) - t;
   for (int k = 0; flo > 0 && k < 60; ++k) lo -= (hi - lo), flo = col.T(lo) - t;
   for (int k = 0; fhi < 0 && k < 60; ++k) hi += (hi - lo), fhi = col.T(hi) - t;
+  return root_in(col, t, lo, hi, flo, fhi, tol);
+}
+
+double BandedField::root_in(const Column& col, double t, double lo, double hi, double flo,
+                            double fhi, double tol) const {
   int side = 0;
   for (int it = 0; it < 200 && hi - lo > tol; ++it) {
     double z = (lo * fhi - hi * flo) / (fhi - flo);
@@ -319,8 +378,53 @@ double BandedField::z_at(const Column& col, double t, double lo_hint, double tol
 void BandedField::z_column(double x, double y, const double* t, double* z, int n,
                            double tol) const {
   const Column col(*this, x, y);
-  for (int i = 0; i < n; ++i)
-    z[i] = z_at(col, t[i], i > 0 && t[i] >= t[i - 1] ? z[i - 1] : kNoHint, tol);
+  // Off z_at's closed forms (a band's own stack) T is piecewise polynomial in z
+  // (Column::pieces): T at the ends of its pieces, then each root inside its piece, by
+  // interpolation where T is linear and on the cubic through four of its values where a band
+  // fades (both exact, to rounding); below and above them all T is T_p. Root-finding each
+  // boundary over a stack's top took about 8 evaluations of T each, 190 a column.
+  std::vector<double> zs, ts;
+  std::vector<std::pair<double, double>> fading;
+  std::size_t cubic_at = SIZE_MAX;  // the piece `cubic` is of
+  std::optional<CubicPiece> cubic;
+  const Band::Basis* basis = nullptr;
+  const Band* only = col.only(&basis);
+  bool linear = !col.planar() && col.pieces(zs, fading);
+  if (linear) {
+    std::sort(zs.begin(), zs.end());
+    zs.erase(std::unique(zs.begin(), zs.end()), zs.end());
+    ts.resize(zs.size());
+    for (std::size_t j = 0; j < zs.size(); ++j) ts[j] = col.T(zs[j]);
+    linear = std::is_sorted(ts.begin(), ts.end());
+  }
+  for (int i = 0; i < n; ++i) {
+    const double hint = i > 0 && t[i] >= t[i - 1] ? z[i - 1] : kNoHint;
+    if (!linear || (only && t[i] <= only->T_bottom + only->N)) {
+      z[i] = z_at(col, t[i], hint, tol);
+      continue;
+    }
+    if (!(t[i] >= ts.front() && t[i] <= ts.back())) {
+      z[i] = pl_.zeta(t[i]);
+      continue;
+    }
+    // The piece [zs[j], zs[j + 1]] with T from ts[j] <= t to ts[j + 1] >= t.
+    const std::size_t j =
+        std::min<std::size_t>(std::upper_bound(ts.begin(), ts.end(), t[i]) - ts.begin(),
+                              ts.size() - 1) -
+        1;
+    const double za = zs[j], zb = zs[j + 1], ta = ts[j], tb = ts[j + 1];
+    const bool fades = std::any_of(fading.begin(), fading.end(),
+                                   [&](const auto& f) { return za < f.second && zb > f.first; });
+    if (!fades) {
+      z[i] = tb > ta ? za + (t[i] - ta) * (zb - za) / (tb - ta) : za;
+      continue;
+    }
+    if (cubic_at != j) {
+      const double f[4] = {ta, col.T(za + (zb - za) / 3), col.T(za + 2 * (zb - za) / 3), tb};
+      cubic.emplace(za, zb, f), cubic_at = j;
+    }
+    z[i] = cubic->root(t[i], tol);
+  }
 }
 
 double BandedField::thickness(double x, double y, double z) const {

@@ -88,8 +88,9 @@ class BandedField final : public LayerField {
   }
   const PlanarLayers& planar() const { return pl_; }
   /// z_at for n layer coordinates t[0..n), increasing, on one vertical line, each within tol
-  /// (mm) of the exact root; each bracket starts from the root below it. For a check over
-  /// many columns of many layers (check_blend in plan_layers.cpp), where 1e-10 mm is not needed.
+  /// (mm) of the exact root: interpolated where T is linear in z between the surfaces, else
+  /// root-found, each bracket starting from the root below it. For a check over many columns
+  /// of many layers (check_blend in plan_layers.cpp), where 1e-10 mm is not needed.
   void z_column(double x, double y, const double* t, double* z, int n, double tol) const;
   /// Where a band can bend the layers: β > 0 only inside [lo, hi] (XY), and the layers only
   /// between c and z_top (its top's highest point over that box, plus its fade), i.e. for
@@ -107,6 +108,9 @@ class BandedField final : public LayerField {
   class Column;
   /// lo_hint: a z where T <= t (NaN: none); tol: the bracket's width to stop at, mm.
   double z_at(const Column& col, double t, double lo_hint, double tol) const;
+  /// The root of T = t in [lo, hi], where T − t is flo <= 0 and fhi >= 0 (Illinois, to tol).
+  double root_in(const Column& col, double t, double lo, double hi, double flo, double fhi,
+                 double tol) const;
   PlanarLayers pl_;
   std::vector<Band> bands_;
   std::vector<Reach> reach_;  ///< per band

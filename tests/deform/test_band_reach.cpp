@@ -71,6 +71,50 @@ TEST(BandedField, AColumnsRootsAreTheFieldsWithinTheTolerance) {
   EXPECT_LE(worst, 1e-7);
 }
 
+// Two domes 22 mm apart over one slab: two bands whose blend zones overlap. Along the line
+// between them a column's T has both bands' surfaces, fades and the first layer's kink; its
+// boundaries (interpolated between T's pieces) are the field's roots, to well within the
+// tolerance, and where a column has no stack of its own above c they fall between the
+// planar ones.
+TEST(BandedField, AColumnThroughTwoBandsHasTheFieldsRoots) {
+  // Each dome on a mesa 4 mm over the slab: their walls split the top into two patches.
+  auto top = [](double x, double y) {
+    for (const double cx : {19.0, 41.0}) {
+      const double r2 = (x - cx) * (x - cx) + (y - 30) * (y - 30);
+      if (r2 < 100) return 14 + 0.02 * (100 - r2);
+    }
+    return 10.0;
+  };
+  TriangleMesh mesh = test::height_field_solid(top, 0, 60, 0, 60, 120, 120);
+  for (Vec3& v : mesh.vertices) v += Vec3(80, 80, 0);
+  PrintConfig c;
+  auto r = slice_model(mesh, make_job(c), {});
+  ASSERT_TRUE(r) << r.error().message;
+  const auto* field = dynamic_cast<const layers::BandedField*>(r->plan.field.get());
+  ASSERT_NE(field, nullptr);
+  ASSERT_EQ(field->bands().size(), 2u);
+  std::vector<double> t;
+  for (double k = 0; k <= 100; k += 1) t.push_back(k);
+  int both = 0;
+  double worst = 0;
+  for (double x = 80; x <= 140; x += 0.37) {
+    const double y = 110.2;
+    int reaching = 0;
+    for (const layers::Band& b : field->bands()) reaching += b.beta(x, y) > 0;
+    both += reaching == 2;
+    std::vector<double> z(t.size());
+    field->z_column(x, y, t.data(), z.data(), static_cast<int>(t.size()), 1e-7);
+    for (std::size_t k = 0; k < t.size(); ++k) {
+      worst = std::max(worst, std::abs(z[k] - field->z_at(x, y, t[k])));
+      if (k > 0) {
+        EXPECT_GT(z[k], z[k - 1]) << "x = " << x << ", t = " << t[k];
+      }
+    }
+  }
+  EXPECT_GT(both, 10);
+  EXPECT_LE(worst, 1e-8);
+}
+
 TEST(GateZones, FindEveryCollisionTheFullCheckFinds) {
   const DomeOnSlab d;
   const SliceResult* r = &d.r;
