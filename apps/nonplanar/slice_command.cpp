@@ -218,9 +218,9 @@ void register_slice(CLI::App& app, std::function<int()>* run_fn) {
   cmd->add_flag("--planar", o->planar, "Planar layers only (the ordinary slicing engine)");
   cmd->add_flag(
       "--timings", o->timings,
-      "Print the wall time of each stage (load, analyze, fit, layers, normalize, "
+      "Print the wall and CPU time of each stage (load, analyze, fit, layers, normalize, "
       "slice, toolpaths or engine, map back, gate, gcode, collisions, stats, write), a retry's "
-      "stages again in order, on stderr");
+      "stages again in order, on stderr; 'cores' below 2 shows a core left idle");
   cmd->add_flag("--preview", o->preview,
                 "Also write OUTPUT.html: the toolpaths in 3D with a slider over the layers "
                 "(see 'preview')");

@@ -1,5 +1,7 @@
 #include "stage_timer.hpp"
 
+#include <time.h>
+
 #include <map>
 
 namespace nonplanar::cli {
@@ -12,12 +14,22 @@ void StageTimer::attach(Context& ctx) {
   };
 }
 
+double StageTimer::cpu_now() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
+
 void StageTimer::report(std::string_view stage) {
   if (!spans_.empty() && spans_.back().stage == stage) return;
   const Clock::time_point now = Clock::now();
-  if (!spans_.empty()) spans_.back().seconds += std::chrono::duration<double>(now - last_).count();
-  last_ = now;
-  spans_.push_back({std::string(stage), 0});
+  const double cpu = cpu_now();
+  if (!spans_.empty()) {
+    spans_.back().seconds += std::chrono::duration<double>(now - last_).count();
+    spans_.back().cpu += cpu - last_cpu_;
+  }
+  last_ = now, last_cpu_ = cpu;
+  spans_.push_back({std::string(stage), 0, 0});
 }
 
 void StageTimer::mark(const std::string& stage) {
@@ -26,15 +38,20 @@ void StageTimer::mark(const std::string& stage) {
 
 void StageTimer::print(std::FILE* out) {
   const Clock::time_point now = Clock::now();
-  if (!spans_.empty()) spans_.back().seconds += std::chrono::duration<double>(now - last_).count();
-  last_ = now;
+  const double cpu = cpu_now();
+  if (!spans_.empty()) {
+    spans_.back().seconds += std::chrono::duration<double>(now - last_).count();
+    spans_.back().cpu += cpu - last_cpu_;
+  }
+  last_ = now, last_cpu_ = cpu;
   const double total = std::chrono::duration<double>(now - start_).count();
-  std::fprintf(out, "timings (wall, s):\n");
+  std::fprintf(out, "timings (s):        wall      cpu  cores\n");
   std::map<std::string, std::pair<double, int>> sums;
   std::vector<std::string> order;
   double timed = 0;
   for (const Span& s : spans_) {
-    std::fprintf(out, "  %-10s %8.3f\n", s.stage.c_str(), s.seconds);
+    std::fprintf(out, "  %-14s %8.3f %8.3f %6.2f\n", s.stage.c_str(), s.seconds, s.cpu,
+                 s.seconds > 0 ? s.cpu / s.seconds : 0.0);
     timed += s.seconds;
     auto [it, fresh] = sums.try_emplace(s.stage, 0.0, 0);
     if (fresh) order.push_back(s.stage);
@@ -45,7 +62,7 @@ void StageTimer::print(std::FILE* out) {
     std::fprintf(out, " %s %.3f%s", s.c_str(), sums[s].first,
                  sums[s].second > 1 ? (" (x" + std::to_string(sums[s].second) + ")").c_str() : "");
   // Before the first report: the command line and profiles.
-  std::fprintf(out, "\n  setup %.3f, total %.3f\n", total - timed, total);
+  std::fprintf(out, "\n  setup %.3f, total %.3f (cpu %.3f)\n", total - timed, total, cpu);
 }
 
 }  // namespace nonplanar::cli

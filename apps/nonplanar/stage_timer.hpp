@@ -1,6 +1,8 @@
 // `slice --timings`: wall time per pipeline stage, read from the stages' progress reports (a
 // stage reports 0 when it starts; context.hpp). A span runs from a stage's first report to the
-// next report of another stage, so a retry shows as the same stages again, in order.
+// next report of another stage, so a retry shows as the same stages again, in order. Beside the
+// wall time, the process's CPU time over the span (all threads): "cores" is their ratio, so
+// a stage that leaves the second core idle shows 1.0 or less.
 #pragma once
 
 #include <chrono>
@@ -25,10 +27,12 @@ class StageTimer {
   using Clock = std::chrono::steady_clock;
   struct Span {
     std::string stage;
-    double seconds = 0;
+    double seconds = 0, cpu = 0;
   };
+  static double cpu_now();
   void report(std::string_view stage);
   Clock::time_point start_ = Clock::now(), last_ = start_;
+  double last_cpu_ = cpu_now();
   std::vector<Span> spans_;
 };
 

@@ -1,4 +1,4 @@
-// `slice --timings` (#20): the stages' wall times, read from their progress reports.
+// `slice --timings` (#20): the stages' wall and CPU times, read from their progress reports.
 #include <gtest/gtest.h>
 
 #include <cstdlib>
@@ -19,14 +19,16 @@ TEST(Timings, EveryStageOfACurvedSliceIsTimedAndTheSpansAddUp) {
   const auto r = test::run_cli("slice " + (dir / "roof.stl").string() + " -o " +
                                (dir / "roof.gcode").string() + " --timings");
   ASSERT_EQ(r.code, 0) << r.err;
-  // The spans, in order, one per line: "  NAME  SECONDS".
+  // The spans, in order, one per line: "  NAME  WALL  CPU  CORES" (seconds, and their ratio).
   std::vector<std::string> order;
-  double sum = 0;
-  const std::regex span(R"(\n  ([a-z ]+?) +([0-9]+\.[0-9]{3})(?=\n))");
+  double sum = 0, cpu = 0;
+  const std::regex span(
+      R"(\n  ([a-z ]+?) +([0-9]+\.[0-9]{3}) +([0-9]+\.[0-9]{3}) +([0-9]+\.[0-9]{2})(?=\n))");
   for (auto it = std::sregex_iterator(r.err.begin(), r.err.end(), span);
        it != std::sregex_iterator(); ++it) {
     order.push_back((*it)[1]);
     sum += std::stod((*it)[2]);
+    cpu += std::stod((*it)[3]);
   }
   // The gate checks the thickness, writes the program, checks its slopes, then looks for
   // collisions in it while the other core measures the file's time and filament (no "stats"
@@ -36,10 +38,14 @@ TEST(Timings, EveryStageOfACurvedSliceIsTimedAndTheSpansAddUp) {
                                          "gate",  "collisions", "write"};
   EXPECT_EQ(order, want) << r.err;
   std::smatch m;
-  ASSERT_TRUE(std::regex_search(r.err, m, std::regex(R"(setup ([0-9.]+), total ([0-9.]+))")))
+  ASSERT_TRUE(std::regex_search(
+      r.err, m, std::regex(R"(setup ([0-9.]+), total ([0-9.]+) \(cpu ([0-9.]+)\))")))
       << r.err;
   EXPECT_NEAR(sum + std::stod(m[1]), std::stod(m[2]), 0.01);
   EXPECT_GT(sum, 0);
+  // The spans' CPU time is the process's since the first span (not the setup's before it).
+  EXPECT_GT(cpu, 0);
+  EXPECT_LE(cpu, std::stod(m[3]) + 0.01);
   // Without the flag, nothing of it.
   const auto q = test::run_cli("slice -q " + (dir / "roof.stl").string() + " -o " +
                                (dir / "roof.gcode").string());
@@ -60,7 +66,7 @@ TEST(Timings, ThroughAnEngineTheReliefsPrintAsShellsInPieces) {
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.err.find("2 curved shells"), std::string::npos) << r.err;
   for (const char* span : {"layers", "engine"}) {
-    const std::regex one(std::string(R"(\n  )") + span + R"( +[0-9]+\.[0-9]{3}\n)");
+    const std::regex one(std::string(R"(\n  )") + span + R"( +[0-9]+\.[0-9]{3} )");
     const auto n = std::distance(std::sregex_iterator(r.err.begin(), r.err.end(), one),
                                  std::sregex_iterator());
     EXPECT_EQ(n, 1) << span << "\n" << r.err;
