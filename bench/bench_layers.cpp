@@ -6,6 +6,7 @@
 #include <cmath>
 #include <vector>
 
+#include "layers/faceted_top.hpp"
 #include "layers/patch_raster.hpp"
 #include "layers/printability_cost.hpp"
 #include "layers/shell_levels.hpp"
@@ -93,6 +94,18 @@ void BM_SliceRibShell(benchmark::State& state) {
   }
 }
 
+// The stack's top on the facets (layers/faceted_top.hpp) for the 50 mm patch: a 0.1 mm
+// raster over the patch and 8 mm around it (580 × 580 nodes), carried outward ring by ring
+// and relaxed. It runs beside the fit, and was the longer of the two on the sine roof.
+void BM_FacetedTop50mm(benchmark::State& state) {
+  const Input& in = input();
+  for (auto _ : state) {
+    const auto t = nonplanar::layers::faceted_top(in.mesh, in.analysis.patches[0], 0.1, 8.0,
+                                                  std::tan(0.8 * 45 * M_PI / 180) / M_SQRT2);
+    state.counters["nodes"] = static_cast<double>(t.h.size());
+  }
+}
+
 // The heights a shell beside a rim prints at (layers/shell_levels.hpp): 200 000 nodes of a
 // 20 mm ramp, each printable up to 0.5 mm after its height, 8 levels over 1000 bins.
 void BM_ChooseLevels(benchmark::State& state) {
@@ -112,5 +125,6 @@ BENCHMARK(BM_PrintabilityCost)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_NormalizeMesh50mm)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_SliceRibShell)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_ChooseLevels)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_FacetedTop50mm)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace
