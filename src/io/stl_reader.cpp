@@ -25,7 +25,9 @@ bool starts_with_solid(std::string_view data) {
 
 // Exact-duplicate index of float triples, growing as needed. A binary STL repeats every
 // shared vertex bit for bit, so merging them while parsing keeps ~1/6 of the corners and
-// never materialises the triangle soup.
+// never materialises the triangle soup. The points are kept as the mesh's own doubles (a float
+// converts exactly, and compares equal exactly when its bits do: no NaN, -0 folded), so
+// they need no copy of their own.
 class FloatPointIndex {
  public:
   explicit FloatPointIndex(std::size_t expected) {
@@ -34,17 +36,18 @@ class FloatPointIndex {
   }
   int insert(const float* p) {
     if (2 * (points_.size() + 1) > slots_.size()) rehash(2 * slots_.size());
+    const Vec3 v(p[0], p[1], p[2]);
     for (std::size_t i = hash(p) & mask_;; i = (i + 1) & mask_) {
       const int s = slots_[i];
       if (s < 0) {
         slots_[i] = static_cast<int>(points_.size());
-        points_.push_back({p[0], p[1], p[2]});
+        points_.push_back(v);
         return slots_[i];
       }
-      if (std::memcmp(points_[s].data(), p, 12) == 0) return s;
+      if (points_[s] == v) return s;
     }
   }
-  const std::vector<std::array<float, 3>>& points() const { return points_; }
+  std::vector<Vec3> take_points() { return std::move(points_); }
 
  private:
   // The x and y bits, then z's, mixed: a product alone left the low bits zero on meshes
@@ -60,14 +63,16 @@ class FloatPointIndex {
     assign_huge(slots_, cap, -1);
     mask_ = cap - 1;
     for (std::size_t s = 0; s < points_.size(); ++s) {
-      std::size_t i = hash(points_[s].data()) & mask_;
+      const float f[3] = {static_cast<float>(points_[s].x()), static_cast<float>(points_[s].y()),
+                          static_cast<float>(points_[s].z())};
+      std::size_t i = hash(f) & mask_;
       while (slots_[i] >= 0) i = (i + 1) & mask_;
       slots_[i] = static_cast<int>(s);
     }
   }
   std::vector<int> slots_;
   std::size_t mask_ = 0;
-  std::vector<std::array<float, 3>> points_;
+  std::vector<Vec3> points_;
 };
 
 Expected<TriangleMesh> parse_binary(std::string_view data, std::uint32_t count) {
@@ -90,8 +95,7 @@ Expected<TriangleMesh> parse_binary(std::string_view data, std::uint32_t count) 
       mesh.faces[t][k] = index.insert(f + 3 * k);
     }
   }
-  reserve_huge(mesh.vertices, index.points().size());
-  for (const auto& q : index.points()) mesh.vertices.emplace_back(q[0], q[1], q[2]);
+  mesh.vertices = index.take_points();
   return mesh;
 }
 
