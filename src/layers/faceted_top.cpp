@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "core/huge_pages.hpp"
+#include "core/parallel.hpp"
 
 namespace nonplanar::layers {
 namespace {
@@ -282,11 +283,12 @@ FacetSamples facet_samples(const TriangleMesh& mesh, const Patch& patch,
     for (int i = i0; i <= i1; ++i)
       for (int j = j0; j <= j1; ++j) bucket[static_cast<std::size_t>(i) * by + j].push_back(f);
   }
-  for (std::size_t k = 0; k < xy.size(); ++k) {
-    if (!want[k]) continue;
+  // Each point on its own, side by side (a start's one patch left the other core idle).
+  core::parallel_for(std::size_t{0}, xy.size(), [&](std::size_t k) {
+    if (!want[k]) return;
     const double x = xy[k].x(), y = xy[k].y();
     if (x < lo.x() - b || y < lo.y() - b || x > lo.x() + ext.x() + b || y > lo.y() + ext.y() + b)
-      continue;  // no triangle near
+      return;  // no triangle near
     const int ci = clampi((x - lo.x()) / b, bx), cj = clampi((y - lo.y()) / b, by);
     double best = -std::numeric_limits<double>::infinity(), near_d = 1e300;
     int inside = -1, nearest = -1;
@@ -304,11 +306,11 @@ FacetSamples facet_samples(const TriangleMesh& mesh, const Patch& patch,
           if (g.squaredNorm() < near_d) near_d = g.squaredNorm(), nearest = f;
         }
     const int f = inside >= 0 ? inside : nearest;
-    if (f < 0) continue;
+    if (f < 0) return;
     const Facet t3(mesh, f);
     out.slope[k] = t3.slope();
     out.h[k] = t3.a.z() + out.slope[k].dot(xy[k] - t3.a.head<2>());
-  }
+  });
   return out;
 }
 
