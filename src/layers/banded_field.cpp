@@ -6,6 +6,7 @@
 #include <limits>
 #include <optional>
 
+#include "core/parallel.hpp"
 #include "nurbs/bspline_basis.hpp"
 
 namespace nonplanar::layers {
@@ -157,12 +158,15 @@ BandedField::BandedField(PlanarLayers pl, std::vector<Band> bands)
     const double cell = b.blend_cell;
     r.lo = b.blend_origin - Vec2(2 * cell, 2 * cell);
     r.hi = b.blend_origin + Vec2((b.blend_nx + 1) * cell, (b.blend_ny + 1) * cell);
-    // The top's highest point, sampled at the raster's nodes; between them a smooth surface
-    // rises by far less than the millimetre of slack.
-    double top = b.c;
-    for (int i = 0; i <= b.blend_nx + 3; ++i)
+    // The top's highest point, sampled at the raster's nodes (a row each, side by side);
+    // between them a smooth surface rises by far less than the millimetre of slack.
+    std::vector<double> row_top(static_cast<std::size_t>(b.blend_nx + 4), b.c);
+    core::parallel_for(0, b.blend_nx + 4, [&](int i) {
       for (int j = 0; j <= b.blend_ny + 3; ++j)
-        top = std::max(top, b.surface(b.basis(r.lo.x() + i * cell, r.lo.y() + j * cell), 0));
+        row_top[i] =
+            std::max(row_top[i], b.surface(b.basis(r.lo.x() + i * cell, r.lo.y() + j * cell), 0));
+    });
+    const double top = *std::max_element(row_top.begin(), row_top.end());
     r.z_top = top + b.fade + 1.0;
     r.t_top = pl_.T(r.z_top);
     reach_.push_back(r);
@@ -236,6 +240,16 @@ class BandedField::Column {
   /// that does not hold or is not worth it: more bands than kept, a band of kKept layers or
   /// more, surfaces not strictly decreasing down to c (a zero-thick layer is a step of T, as is
   /// S_N under c by more than rounding), or no fade (a step at S_0).
+  /// The same for a column of one band's own stack (only()), above its top: S_0, S_0 + L_rec
+  /// and h₁ if between them (under S_0 z_at's closed form holds).
+  bool fade_pieces(std::vector<double>& z, std::vector<std::pair<double, double>>& fading) const {
+    if (field_ || n_ != 1 || !(band_[0]->fade > 0)) return false;
+    const double S0 = surface(0, 0), top = S0 + band_[0]->fade;
+    z = {S0, top};
+    if (pl_.h1 > S0 && pl_.h1 < top) z.push_back(pl_.h1);
+    fading.emplace_back(S0, top);
+    return true;
+  }
   bool pieces(std::vector<double>& z, std::vector<std::pair<double, double>>& fading) const {
     if (field_) return false;
     z.push_back(pl_.h1);
@@ -379,17 +393,18 @@ void BandedField::z_column(double x, double y, const double* t, double* z, int n
                            double tol) const {
   const Column col(*this, x, y);
   // Off z_at's closed forms (a band's own stack) T is piecewise polynomial in z
-  // (Column::pieces): T at the ends of its pieces, then each root inside its piece, by
-  // interpolation where T is linear and on the cubic through four of its values where a band
-  // fades (both exact, to rounding); below and above them all T is T_p. Root-finding each
-  // boundary over a stack's top took about 8 evaluations of T each, 190 a column.
+  // (Column::pieces, fade_pieces over a stack's top): T at the ends of its pieces, then each
+  // root inside its piece, by interpolation where T is linear and on the cubic through four
+  // of its values where a band fades (both exact, to rounding); below and above them all T is
+  // T_p. Root-finding each boundary over a stack's top took about 8 evaluations of T each,
+  // 190 a column.
   std::vector<double> zs, ts;
   std::vector<std::pair<double, double>> fading;
   std::size_t cubic_at = SIZE_MAX;  // the piece `cubic` is of
   std::optional<CubicPiece> cubic;
   const Band::Basis* basis = nullptr;
   const Band* only = col.only(&basis);
-  bool linear = !col.planar() && col.pieces(zs, fading);
+  bool linear = only ? col.fade_pieces(zs, fading) : !col.planar() && col.pieces(zs, fading);
   if (linear) {
     std::sort(zs.begin(), zs.end());
     zs.erase(std::unique(zs.begin(), zs.end()), zs.end());
@@ -403,8 +418,14 @@ void BandedField::z_column(double x, double y, const double* t, double* z, int n
       z[i] = z_at(col, t[i], hint, tol);
       continue;
     }
-    if (!(t[i] >= ts.front() && t[i] <= ts.back())) {
+    // Past the last piece T is T_p; before the first too, unless that is a stack's top (then
+    // t is a hair over the stack's T by rounding: root-found).
+    if (t[i] > ts.back() || (!only && t[i] < ts.front())) {
       z[i] = pl_.zeta(t[i]);
+      continue;
+    }
+    if (t[i] < ts.front()) {
+      z[i] = z_at(col, t[i], hint, tol);
       continue;
     }
     // The piece [zs[j], zs[j + 1]] with T from ts[j] <= t to ts[j + 1] >= t.

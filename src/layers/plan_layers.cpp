@@ -70,21 +70,29 @@ std::string check_blend(const BandedField& field, const Band& b, const ColumnCas
   const double step = 0.5;
   const int stride = std::max(1, static_cast<int>(step / b.blend_cell));
   double top_max = -1e300;
-  double S[512];
-  // Columns: every stride-th node of the blend raster.
+  // Columns: every stride-th node of the blend raster, found a row at a time side by side
+  // (with the highest top among them), then listed in order.
   std::map<std::pair<int, int>, std::vector<double>> zk;  // layer boundary heights per column
   const double T0 = b.T_bottom;
-  std::vector<std::pair<int, int>> cols;
-  for (int i = 0; i < b.blend_nx; i += stride)
+  const int rows = (b.blend_nx + stride - 1) / stride;
+  std::vector<std::vector<int>> row_cols(static_cast<std::size_t>(rows));
+  std::vector<double> row_top(static_cast<std::size_t>(rows), -1e300);
+  core::parallel_for(0, rows, [&](int r) {
+    const int i = r * stride;
     for (int j = 0; j < b.blend_ny; j += stride) {
       const double x = b.blend_origin.x() + i * b.blend_cell,
                    y = b.blend_origin.y() + j * b.blend_cell;
       const double beta = b.beta(x, y);
       if (beta <= 0 || beta >= 1) continue;
-      b.heights(x, y, S);
-      top_max = std::max(top_max, S[0]);
-      cols.emplace_back(i, j);
+      row_top[r] = std::max(row_top[r], b.surface(b.basis(x, y), 0));
+      row_cols[r].push_back(j);
     }
+  });
+  std::vector<std::pair<int, int>> cols;
+  for (int r = 0; r < rows; ++r) {
+    top_max = std::max(top_max, row_top[r]);
+    for (const int j : row_cols[r]) cols.emplace_back(r * stride, j);
+  }
   if (cols.empty()) return {};
   const int k_hi = static_cast<int>(std::ceil(field.t_of_zeta(top_max + b.fade))) + 1;
   // Layer boundaries per column (root-finding: the cost of this check), in parallel; the
