@@ -148,7 +148,10 @@ Expected<SliceResult> attempt(const TriangleMesh& mesh, const SliceJob& job, con
   auto sliced = slice_with(*to_slice, r.nonplanar ? r.plan.field.get() : nullptr, route, ctx);
   if (!sliced) return sliced.error();
   r.layers = std::move(sliced->layers);
-  if (!sliced->gcode.empty()) r.gcode = engine_header(route, r.header, 0) + sliced->gcode;
+  // The header goes in front in the text's own room (take_text leaves some): a joined copy
+  // held the whole print twice.
+  r.gcode = std::move(sliced->gcode);
+  if (!r.gcode.empty()) r.gcode.insert(0, engine_header(route, r.header, 0));
   // The band a location belongs to: the one whose blend weight β is largest there (the
   // stacks and the field's bands are in the same order).
   const auto* banded = dynamic_cast<const layers::BandedField*>(r.plan.field.get());
@@ -311,7 +314,9 @@ Expected<std::optional<SliceResult>> try_shell(const TriangleMesh& mesh, const S
     r.plan = *stacks;
     r.printed_curved += static_cast<int>(stacks->stacks.size());
   }
-  if (!r.gcode.empty()) r.gcode = engine_header(route, r.header, plan.core.at(1), pieces) + r.gcode;
+  // In the text's own room, as above (the bunny's 28.6 MB were held twice at the engine
+  // route's peak: 168-172 MB against PrusaSlicer's 168).
+  if (!r.gcode.empty()) r.gcode.insert(0, engine_header(route, r.header, plan.core.at(1), pieces));
   r.nonplanar = true;
   spent();
   std::string breach;
