@@ -61,19 +61,9 @@ bool reaches(const Band& a, const Band& b) {
          b_lo.y() <= a_hi.y();
 }
 
-// Layers through the blend zone of band `b` (0 < β < 1) where there is material: thickness
-// and slope. Returns a reason, or empty. Columns every 0.5 mm: at 1 mm a thin part (the
-// bunny's ear) left few neighbouring columns both in material, and a 30.3° blend there was
-// found only in the final paths, after a whole slice (through PrusaSlicer, a run more).
-std::string check_blend(const BandedField& field, const Band& b, const ColumnCaster& columns,
-                        const LayerParams& p) {
-  const double step = 0.5;
-  const int stride = std::max(1, static_cast<int>(step / b.blend_cell));
-  double top_max = -1e300;
-  // Columns: every stride-th node of the blend raster, found a row at a time side by side
-  // (with the highest top among them), then listed in order.
-  std::map<std::pair<int, int>, std::vector<double>> zk;  // layer boundary heights per column
-  const double T0 = b.T_bottom;
+// check_blend's columns: every stride-th node (i, j) of b's blend raster where 0 < β < 1, in
+// order, found a row at a time side by side; *top_max the highest S_0 among them.
+std::vector<std::pair<int, int>> blend_columns(const Band& b, int stride, double* top_max) {
   const int rows = (b.blend_nx + stride - 1) / stride;
   std::vector<std::vector<int>> row_cols(static_cast<std::size_t>(rows));
   std::vector<double> row_top(static_cast<std::size_t>(rows), -1e300);
@@ -90,9 +80,24 @@ std::string check_blend(const BandedField& field, const Band& b, const ColumnCas
   });
   std::vector<std::pair<int, int>> cols;
   for (int r = 0; r < rows; ++r) {
-    top_max = std::max(top_max, row_top[r]);
+    *top_max = std::max(*top_max, row_top[r]);
     for (const int j : row_cols[r]) cols.emplace_back(r * stride, j);
   }
+  return cols;
+}
+
+// Layers through the blend zone of band `b` (0 < β < 1) where there is material: thickness
+// and slope. Returns a reason, or empty. Columns every 0.5 mm: at 1 mm a thin part (the
+// bunny's ear) left few neighbouring columns both in material, and a 30.3° blend there was
+// found only in the final paths, after a whole slice (through PrusaSlicer, a run more).
+std::string check_blend(const BandedField& field, const Band& b, const ColumnCaster& columns,
+                        const LayerParams& p) {
+  const double step = 0.5;
+  const int stride = std::max(1, static_cast<int>(step / b.blend_cell));
+  double top_max = -1e300;
+  const std::vector<std::pair<int, int>> cols = blend_columns(b, stride, &top_max);
+  std::map<std::pair<int, int>, std::vector<double>> zk;  // layer boundary heights per column
+  const double T0 = b.T_bottom;
   if (cols.empty()) return {};
   const int k_hi = static_cast<int>(std::ceil(field.t_of_zeta(top_max + b.fade))) + 1;
   // Layer boundaries per column (root-finding: the cost of this check), in parallel; the
