@@ -20,8 +20,7 @@ double StageTimer::cpu_now() {
   return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
 }
 
-void StageTimer::report(std::string_view stage) {
-  if (!spans_.empty() && spans_.back().stage == stage) return;
+void StageTimer::close_span() {
   const Clock::time_point now = Clock::now();
   const double cpu = cpu_now();
   if (!spans_.empty()) {
@@ -29,6 +28,11 @@ void StageTimer::report(std::string_view stage) {
     spans_.back().cpu += cpu - last_cpu_;
   }
   last_ = now, last_cpu_ = cpu;
+}
+
+void StageTimer::report(std::string_view stage) {
+  if (!spans_.empty() && spans_.back().stage == stage) return;
+  close_span();
   spans_.push_back({std::string(stage), 0, 0});
 }
 
@@ -37,14 +41,8 @@ void StageTimer::mark(const std::string& stage) {
 }
 
 void StageTimer::print(std::FILE* out) {
-  const Clock::time_point now = Clock::now();
-  const double cpu = cpu_now();
-  if (!spans_.empty()) {
-    spans_.back().seconds += std::chrono::duration<double>(now - last_).count();
-    spans_.back().cpu += cpu - last_cpu_;
-  }
-  last_ = now, last_cpu_ = cpu;
-  const double total = std::chrono::duration<double>(now - start_).count();
+  close_span();
+  const double total = std::chrono::duration<double>(last_ - start_).count();
   std::fprintf(out, "timings (s):        wall      cpu  cores\n");
   std::map<std::string, std::pair<double, int>> sums;
   std::vector<std::string> order;
@@ -62,7 +60,7 @@ void StageTimer::print(std::FILE* out) {
     std::fprintf(out, " %s %.3f%s", s.c_str(), sums[s].first,
                  sums[s].second > 1 ? (" (x" + std::to_string(sums[s].second) + ")").c_str() : "");
   // Before the first report: the command line and profiles.
-  std::fprintf(out, "\n  setup %.3f, total %.3f (cpu %.3f)\n", total - timed, total, cpu);
+  std::fprintf(out, "\n  setup %.3f, total %.3f (cpu %.3f)\n", total - timed, total, last_cpu_);
 }
 
 }  // namespace nonplanar::cli

@@ -30,6 +30,8 @@ class StageTimer {
     double seconds = 0, cpu = 0;
   };
   static double cpu_now();
+  /// Adds the wall and CPU time since the last report to the current span (if any).
+  void close_span();
   void report(std::string_view stage);
   Clock::time_point start_ = Clock::now(), last_ = start_;
   double last_cpu_ = cpu_now();

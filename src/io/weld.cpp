@@ -13,22 +13,18 @@
 namespace nonplanar::io {
 namespace {
 
-std::uint64_t mix(std::uint64_t h) {
-  return mix64(h);
-}
-
 std::uint64_t hash_point(const Vec3& p) {
   std::uint64_t b[3];
   for (int k = 0; k < 3; ++k) {
     const double v = p[k] == 0.0 ? 0.0 : p[k];  // +0 and -0 are the same point
     std::memcpy(&b[k], &v, 8);
   }
-  return mix(b[0] ^ mix(b[1] ^ mix(b[2])));
+  return mix64(b[0] ^ mix64(b[1] ^ mix64(b[2])));
 }
 
 std::uint64_t hash_cell(std::int64_t x, std::int64_t y, std::int64_t z) {
-  return mix(static_cast<std::uint64_t>(x) * 0x9E3779B97F4A7C15ULL ^
-             mix(static_cast<std::uint64_t>(y) ^ mix(static_cast<std::uint64_t>(z))));
+  return mix64(static_cast<std::uint64_t>(x) * 0x9E3779B97F4A7C15ULL ^
+               mix64(static_cast<std::uint64_t>(y) ^ mix64(static_cast<std::uint64_t>(z))));
 }
 
 // Open-addressing table of int values keyed by a 64-bit hash; the caller resolves collisions
@@ -194,9 +190,9 @@ std::size_t remove_duplicate_faces(TriangleMesh& mesh, std::vector<int>* tags) {
     return f;
   };
   auto hash = [](const std::array<int, 3>& k) {
-    return mix(static_cast<std::uint64_t>(static_cast<std::uint32_t>(k[0])) ^
-               mix(static_cast<std::uint64_t>(static_cast<std::uint32_t>(k[1])) << 32 ^
-                   static_cast<std::uint32_t>(k[2])));
+    return mix64(static_cast<std::uint64_t>(static_cast<std::uint32_t>(k[0])) ^
+                 mix64(static_cast<std::uint64_t>(static_cast<std::uint32_t>(k[1])) << 32 ^
+                       static_cast<std::uint32_t>(k[2])));
   };
   IndexTable table(mesh.faces.size());
   std::size_t kept = 0;

@@ -234,13 +234,7 @@ class BandedField::Column {
     return kept_[k][i];
   }
   bool planar() const { return n_ == 0 && !field_; }
-  /// The heights where T's pieces meet, into `z` (unsorted): h₁, and per band c, S_N … S_0 and
-  /// S_0 + L_rec. Between two neighbours T is linear in z (T_p and every δ_b are), except
-  /// where a band's δ fades over (S_0, S_0 + L_rec): those spans go to `fading`. False where
-  /// that does not hold or is not worth it: more bands than kept, a band of kKept layers or
-  /// more, surfaces not strictly decreasing down to c (a zero-thick layer is a step of T, as is
-  /// S_N under c by more than rounding), or no fade (a step at S_0).
-  /// The same for a column of one band's own stack (only()), above its top: S_0, S_0 + L_rec
+  /// pieces() for a column of one band's own stack (only()), above its top: S_0, S_0 + L_rec
   /// and h₁ if between them (under S_0 z_at's closed form holds).
   bool fade_pieces(std::vector<double>& z, std::vector<std::pair<double, double>>& fading) const {
     if (field_ || n_ != 1 || !(band_[0]->fade > 0)) return false;
@@ -250,6 +244,12 @@ class BandedField::Column {
     fading.emplace_back(S0, top);
     return true;
   }
+  /// The heights where T's pieces meet, into `z` (unsorted): h₁, and per band c, S_N … S_0 and
+  /// S_0 + L_rec. Between two neighbours T is linear in z (T_p and every δ_b are), except
+  /// where a band's δ fades over (S_0, S_0 + L_rec): those spans go to `fading`. False where
+  /// that does not hold or is not worth it: more bands than kept, a band of kKept layers or
+  /// more, surfaces not strictly decreasing down to c (a zero-thick layer is a step of T, as is
+  /// S_N under c by more than rounding), or no fade (a step at S_0).
   bool pieces(std::vector<double>& z, std::vector<std::pair<double, double>>& fading) const {
     if (field_) return false;
     z.push_back(pl_.h1);
@@ -404,17 +404,17 @@ void BandedField::z_column(double x, double y, const double* t, double* z, int n
   std::optional<CubicPiece> cubic;
   const Band::Basis* basis = nullptr;
   const Band* only = col.only(&basis);
-  bool linear = only ? col.fade_pieces(zs, fading) : !col.planar() && col.pieces(zs, fading);
-  if (linear) {
+  bool pieced = only ? col.fade_pieces(zs, fading) : !col.planar() && col.pieces(zs, fading);
+  if (pieced) {
     std::sort(zs.begin(), zs.end());
     zs.erase(std::unique(zs.begin(), zs.end()), zs.end());
     ts.resize(zs.size());
     for (std::size_t j = 0; j < zs.size(); ++j) ts[j] = col.T(zs[j]);
-    linear = std::is_sorted(ts.begin(), ts.end());
+    pieced = std::is_sorted(ts.begin(), ts.end());
   }
   for (int i = 0; i < n; ++i) {
     const double hint = i > 0 && t[i] >= t[i - 1] ? z[i - 1] : kNoHint;
-    if (!linear || (only && t[i] <= only->T_bottom + only->N)) {
+    if (!pieced || (only && t[i] <= only->T_bottom + only->N)) {
       z[i] = z_at(col, t[i], hint, tol);
       continue;
     }

@@ -88,9 +88,9 @@ class BandedField final : public LayerField {
   }
   const PlanarLayers& planar() const { return pl_; }
   /// z_at for n layer coordinates t[0..n), increasing, on one vertical line, each within tol
-  /// (mm) of the exact root: interpolated where T is linear in z between the surfaces, else
-  /// root-found, each bracket starting from the root below it. For a check over many columns
-  /// of many layers (check_blend in plan_layers.cpp), where 1e-10 mm is not needed.
+  /// (mm) of the exact root: on T's pieces between the surfaces (a line, or a cubic where a
+  /// band fades) where they are known, else root-found from the root below it. For a check over
+  /// many columns of many layers (check_blend in plan_layers.cpp), where 1e-10 mm is not needed.
   void z_column(double x, double y, const double* t, double* z, int n, double tol) const;
   /// Where a band can bend the layers: β > 0 only inside [lo, hi] (XY), and the layers only
   /// between c and z_top (its top's highest point over that box, plus its fade), i.e. for
