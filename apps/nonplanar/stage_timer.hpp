@@ -2,12 +2,17 @@
 // stage reports 0 when it starts; context.hpp). A span runs from a stage's first report to the
 // next report of another stage, so a retry shows as the same stages again, in order. Beside the
 // wall time, the process's CPU time over the span (all threads): "cores" is their ratio, so
-// a stage that leaves the second core idle shows 1.0 or less.
+// a stage that leaves the second core idle shows 1.0 or less. "rss MB" is the process's
+// resident size when the span ends, "peak MB" its high-water mark so far (Linux: VmRSS and
+// VmHWM): the span where the peak rises is the stage that raised it. (Not reset per span
+// through /proc/self/clear_refs: that would also reset what getrusage, and so /usr/bin/time,
+// reports as the run's peak.)
 #pragma once
 
 #include <chrono>
 #include <cstdio>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "nonplanar/context.hpp"
@@ -28,8 +33,11 @@ class StageTimer {
   struct Span {
     std::string stage;
     double seconds = 0, cpu = 0;
+    double rss_mb = 0, peak_mb = 0;  ///< at the span's end (0: unknown)
   };
   static double cpu_now();
+  /// The process's resident size and its high-water mark, MB (0 where /proc cannot tell).
+  static std::pair<double, double> memory_mb();
   /// Adds the wall and CPU time since the last report to the current span (if any).
   void close_span();
   void report(std::string_view stage);

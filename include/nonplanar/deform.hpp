@@ -162,6 +162,11 @@ struct ForeignMapOptions {
 Expected<ForeignGcode> map_foreign_gcode(std::string_view text, const LayerField& field,
                                          const MapBackParams& params, const Context& ctx,
                                          const ForeignMapOptions& options = {});
+/// The same, consuming the text: the memory of what has been read goes back to the system as
+/// the map goes, and the text is gone when it returns (an engine's file, read once).
+Expected<ForeignGcode> map_foreign_gcode_consuming(std::string&& text, const LayerField& field,
+                                                   const MapBackParams& params, const Context& ctx,
+                                                   const ForeignMapOptions& options = {});
 
 /// Splits every edge whose mapped midpoint is farther than the tolerance from the mapped
 /// chord (conforming: both faces of an edge split it), then maps every vertex. A closed,

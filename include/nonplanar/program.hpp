@@ -235,6 +235,10 @@ class GcodePieceReader {
   Piece piece() const;
   /// The file's line (0-based) that the piece's first line is.
   std::size_t first_line() const;
+  /// The first byte of the text that the reader still views (the piece's first line, or the
+  /// ;TYPE: in force, which its moves and the next pieces' view, if earlier): what lies before
+  /// it is never read again, and its memory may go (map_foreign_gcode's consuming form).
+  std::size_t held_from() const;
   /// The print's layers (its ;LAYER_CHANGE lines), known from the start.
   std::size_t layer_count() const;
   GcodeProgram& program();

@@ -36,13 +36,13 @@ Expected<EngineOutput> external(const TriangleMesh& to_slice, const LayerField* 
   if (!text) return text.error();
   ctx.progress("map back", 0);
   const auto planar = planar_field(route.layers);
-  auto mapped = map_foreign_gcode(*text, field ? *field : *planar, route.map_back, ctx);
+  auto mapped =
+      map_foreign_gcode_consuming(std::move(*text), field ? *field : *planar, route.map_back, ctx);
   if (!mapped) {
     Error e = mapped.error();
     e.message = "engine G-code, " + e.message;
     return e;
   }
-  std::string().swap(*text);  // (the mapped program holds no view of it)
   EngineOutput out;
   out.layers = std::move(mapped->layers);
   out.gcode = mapped->take_text();

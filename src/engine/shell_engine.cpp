@@ -182,14 +182,13 @@ namespace {
 
 // The core's G-code mapped and cut back under the shells (one core: plans[0]'s boundaries),
 // with what `opt` says besides.
-Expected<ForeignGcode> map_core(std::string_view core_text,
-                                std::span<const layers::ShellPlan> plans, const EngineRoute& job,
-                                const Context& ctx, ForeignMapOptions opt) {
+Expected<ForeignGcode> map_core(std::string core_text, std::span<const layers::ShellPlan> plans,
+                                const EngineRoute& job, const Context& ctx, ForeignMapOptions opt) {
   const layers::ShellPlan& plan = plans.front();
   const CoreClip clip(plans, 0.5 * job.print.paths.perimeter_width);
   opt.clip = &clip;
   const auto planar = planar_field(job.layers);
-  auto core = map_foreign_gcode(core_text, *planar, job.map_back, ctx, opt);
+  auto core = map_foreign_gcode_consuming(std::move(core_text), *planar, job.map_back, ctx, opt);
   if (!core) {
     Error e = core.error();
     e.message = "engine G-code (core), " + e.message;
@@ -212,12 +211,12 @@ Expected<ForeignGcode> map_core(std::string_view core_text,
 
 }  // namespace
 
-Expected<ForeignGcode> map_shell_core(std::string_view core_text, const layers::ShellPlan& plan,
+Expected<ForeignGcode> map_shell_core(std::string core_text, const layers::ShellPlan& plan,
                                       const EngineRoute& job, const Context& ctx,
                                       std::vector<char> others) {
   ForeignMapOptions opt;
   opt.planar_lines = std::move(others);
-  return map_core(core_text, std::span(&plan, 1), job, ctx, std::move(opt));
+  return map_core(std::move(core_text), std::span(&plan, 1), job, ctx, std::move(opt));
 }
 
 namespace {
@@ -294,9 +293,8 @@ Expected<EngineShell> shell_with_engine(const TriangleMesh& mesh, const layers::
     return e;
   }
   std::string().swap(*text);
-  auto core = map_shell_core(split->core, plan, job, ctx);
+  auto core = map_shell_core(std::move(split->core), plan, job, ctx);
   if (!core) return core.error();
-  std::string().swap(split->core);
   ctx.progress("core", 1.0);
   return join_shell(std::move(*core), split->shell, plan, stack->base, job,
                     "the shell's curved layers, from the engine's layers above the core", ctx);
@@ -353,9 +351,8 @@ Expected<EngineShell> shell_pieces_with_engine(const TriangleMesh& mesh,
   };
   opt.filament_per_mm = [&](double w, double h) { return filament_per_mm(w, h, job.print.gcode); };
   opt.inserted_travel_speed = job.print.paths.travel_speed;
-  auto core = map_core(*text, plans, job, ctx, std::move(opt));
+  auto core = map_core(std::move(*text), plans, job, ctx, std::move(opt));
   if (!core) return core.error();
-  std::string().swap(*text);
   ctx.progress("core", 1.0);
   EngineShell out;
   out.layers = std::move(core->layers);

@@ -82,8 +82,9 @@ Expected<EngineShell> shell_pieces_with_engine(const TriangleMesh& mesh,
 /// under the shell, as shell_with_engine maps its first run; the moves of `others` (0-based
 /// lines of core_text; empty: none) are other objects', left as written and neither cut nor
 /// held to the boundaries. Errors: those of the mapping, and unsupported for a layer of the
-/// part off the planned boundaries (the profile was not followed).
-Expected<ForeignGcode> map_shell_core(std::string_view core_text, const layers::ShellPlan& plan,
+/// part off the planned boundaries (the profile was not followed). The text is consumed as it
+/// is mapped (map_foreign_gcode's consuming form).
+Expected<ForeignGcode> map_shell_core(std::string core_text, const layers::ShellPlan& plan,
                                       const EngineRoute& job, const Context& ctx,
                                       std::vector<char> others = {});
 

@@ -395,9 +395,8 @@ Expected<EngineShell> map_shell_gcode(ShellSplit& sp, const Vec2& moved, const S
   const layers::ShellPlan& shell = sp.plan;
   sp.plan.top.origin += moved;  // H follows the part on the plate
   const EngineRoute route{job.engine, job.print, job.layers, job.map_back};
-  auto core = map_shell_core(sp.core, shell, route, ctx, std::move(sp.others));
+  auto core = map_shell_core(std::move(sp.core), shell, route, ctx, std::move(sp.others));
   if (!core) return core.error();
-  std::string().swap(sp.core);
   return join_shell(std::move(*core), sp.shell, shell, shell.core.back() + shell.t, route,
                     "the shell's curved layers, from the slicer's layers above the core", ctx);
 }

@@ -99,6 +99,10 @@ class Reader {
   void read_to(std::size_t end);
   std::size_t lines() const { return n_; }
   std::size_t at_line() const { return i_; }
+  std::size_t at_byte() const { return at_; }
+  /// The ;TYPE: in force ("" before any), a view of the text.
+  std::string_view type() const { return type_; }
+  std::string_view text() const { return text_; }
   const GcodeState& state() const { return s_; }
   /// The ;LAYER_CHANGE lines of the print (each starts one of its layers).
   const std::vector<std::size_t>& layer_lines() const { return layer_lines_; }
@@ -387,6 +391,7 @@ struct GcodePieceReader::Impl {
   Piece piece = Piece::start;
   bool started = false;
   std::size_t first = 0, next_layer = 0;
+  std::size_t first_byte = 0;  // the piece's first line's
 };
 
 GcodePieceReader::GcodePieceReader(std::string_view text) : impl_(std::make_unique<Impl>(text)) {}
@@ -412,7 +417,7 @@ bool GcodePieceReader::next(std::size_t layers) {
     return false;
   }
   m.p.lines.clear(), m.p.moves.clear(), m.p.problems.clear();
-  m.first = m.reader.at_line();
+  m.first = m.reader.at_line(), m.first_byte = m.reader.at_byte();
   m.reader.read_to(to);
   if (m.piece == Piece::start && m.p.print_begin < m.reader.lines())
     m.p.at_print = m.reader.state();
@@ -427,6 +432,12 @@ std::size_t GcodePieceReader::first_line() const {
 }
 std::size_t GcodePieceReader::layer_count() const {
   return impl_->reader.layer_lines().size();
+}
+std::size_t GcodePieceReader::held_from() const {
+  const Impl& m = *impl_;
+  const std::string_view type = m.reader.type();
+  if (type.empty()) return m.first_byte;
+  return std::min(m.first_byte, static_cast<std::size_t>(type.data() - m.reader.text().data()));
 }
 GcodeProgram& GcodePieceReader::program() {
   return impl_->p;

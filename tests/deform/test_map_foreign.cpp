@@ -155,6 +155,55 @@ TEST(MapForeignGcode, LayersMappedSideBySideWriteWhatOneAtATimeDoes) {
   EXPECT_NE(c.error().message.find("mapped points"), std::string::npos) << c.error().message;
 }
 
+// The consuming form hands back the pages of what it has read as it goes (one layer at a time
+// here) and writes what reading the text whole does: also where one ;TYPE: at the start is in
+// force through the whole file (its moves view that line, which must not go).
+TEST(MapForeignGcode, ConsumingTheTextWritesWhatReadingItDoes) {
+  const NormalisedSaddle saddle;
+  // (After a long start, so that the ;TYPE: line is on a page of its own that could go.)
+  std::string one_type;
+  for (int i = 0; i < 1000; ++i) one_type += "; a long start G-code\n";
+  bool typed = false;
+  for (std::size_t at = 0; at < saddle.planar.size();) {
+    std::size_t end = saddle.planar.find('\n', at);
+    end = end == std::string::npos ? saddle.planar.size() : end + 1;
+    const std::string_view l(saddle.planar.data() + at, end - at);
+    if (l.rfind(";TYPE:", 0) != 0)
+      one_type += l;
+    else if (!typed && l.rfind(";TYPE:Custom", 0) != 0)
+      one_type += ";TYPE:Perimeter\n", typed = true;
+    at = end;
+  }
+  ASSERT_TRUE(typed);
+  ASSERT_GT(one_type.size(), 40 * 4096u);
+  ForeignMapOptions windows;
+  windows.layers_at_once = 1;
+  for (const std::string* text : {&saddle.planar, static_cast<const std::string*>(&one_type)}) {
+    auto a = map_foreign_gcode(*text, *saddle.plan.field, {}, {}, windows);
+    auto b = map_foreign_gcode_consuming(std::string(*text), *saddle.plan.field, {}, {}, windows);
+    ASSERT_TRUE(a && b);
+    EXPECT_TRUE(a->text() == b->text());
+    ASSERT_EQ(a->layers.size(), b->layers.size());
+    ASSERT_GT(a->layers.size(), 20u);
+    std::size_t perimeters = 0;
+    for (std::size_t i = 0; i < a->layers.size(); ++i) {
+      ASSERT_EQ(a->layers[i].paths.size(), b->layers[i].paths.size());
+      for (std::size_t k = 0; k < a->layers[i].paths.size(); ++k) {
+        EXPECT_EQ(a->layers[i].paths[k].role, b->layers[i].paths[k].role);
+        EXPECT_EQ(a->layers[i].paths[k].points, b->layers[i].paths[k].points);
+        perimeters += a->layers[i].paths[k].role == ExtrusionRole::perimeter;
+      }
+    }
+    // With one type, every path is a perimeter (a view read as zeros would be solid infill).
+    if (text == &one_type) {
+      std::size_t paths = 0;
+      for (const LayerToolpaths& L : a->layers) paths += L.paths.size();
+      EXPECT_EQ(perimeters, paths);
+      EXPECT_GT(paths, 50u);
+    }
+  }
+}
+
 // Paths given by before_layer go between the file's layers, each a layer of its own: the
 // file's retractions still balance (the filament pulled back for the travel to them is owed to
 // the file's next E), the filament pushed is the file's and theirs, and the nozzle, waiting

@@ -325,6 +325,46 @@ TEST(ReadProgram, PiecesReadAsTheWholeFile) {
   EXPECT_FALSE(reader.next(2));
 }
 
+// What the reader still views (GcodePieceReader::held_from): the piece's first line, or
+// earlier the ;TYPE: in force, which the moves of a piece without one of its own view; the
+// text before it may go (map_foreign_gcode_consuming).
+TEST(ReadProgram, APieceHoldsItsLinesAndTheTypeInForce) {
+  std::string layers;
+  for (int k = 3; k <= 8; ++k) {
+    const std::string z = std::to_string(0.2 * k);
+    layers += ";LAYER_CHANGE\n;Z:" + z + "\n;HEIGHT:0.2\nG1 Z" + z + " F720\n";
+    if (k == 7) layers += ";TYPE:Solid infill\n";  // layers 5 and 6 keep the kPrint's last
+    layers += "G1 X" + std::to_string(10 + k) + " Y20 E0.5\n";
+  }
+  const std::string text = kPrusaStart + kPrint + layers + kEnd;
+  const std::size_t top = text.find(";TYPE:Top solid infill") + 6;
+  const std::size_t solid = text.find(";TYPE:Solid infill") + 6;
+  GcodePieceReader reader(text);
+  std::vector<std::size_t> held, first;
+  while (reader.next(1)) {
+    const GcodeProgram& p = reader.program();
+    held.push_back(reader.held_from());
+    first.push_back(p.lines.empty()
+                        ? text.size()
+                        : static_cast<std::size_t>(p.lines[0].raw.data() - text.data()));
+    if (reader.piece() != GcodePieceReader::Piece::layers) continue;
+    for (const GcodeMove& m : p.moves) {
+      if (!m.extruding()) continue;
+      EXPECT_LE(held.back(), static_cast<std::size_t>(m.type.data() - text.data()));
+    }
+  }
+  // start, kPrint's two layers, layers 3 to 8, the end.
+  ASSERT_EQ(held.size(), 10u);
+  EXPECT_EQ(held[0], 0u);        // no type yet
+  EXPECT_EQ(held[1], first[1]);  // its own ;TYPE: comes after its first line
+  EXPECT_EQ(held[2], first[2]);
+  for (std::size_t k = 3; k <= 6; ++k) EXPECT_EQ(held[k], top) << k;  // layers 3 to 6
+  EXPECT_LT(held[6], first[6]);
+  EXPECT_EQ(held[7], first[7]);  // layer 7's own ;TYPE:
+  EXPECT_EQ(held[8], solid);
+  EXPECT_EQ(held[9], first[9]);  // the end begins with its ;TYPE:Custom
+}
+
 // A file without layers is one start piece (the whole file), an empty end, and no more.
 TEST(ReadProgram, PiecesOfAFileWithoutLayers) {
   GcodePieceReader reader(kPrusaStart);
