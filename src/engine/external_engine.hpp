@@ -65,10 +65,11 @@ using EarlyEnginePtr = std::unique_ptr<EarlyEngine, EarlyEngineDeleter>;
 /// z only (the normalised one, or the part itself as a shell's core: its XY box centred where
 /// this one's is), with e and c as run_engine will be given them. Null for OrcaSlicer, for a
 /// mesh PrusaSlicer would repair (open, non-manifold or inconsistently wound edges: it repairs
-/// an STL and not an AMF), or when it cannot start (run_engine then starts its own and reports
-/// what goes wrong).
+/// an STL and not an AMF) unless `layer_tops` (then one that reads the 3MF a run with layer
+/// tops is given, and takes only such a run: for a run known to come, as a shell's core), or
+/// when it cannot start (run_engine then starts its own and reports what goes wrong).
 EarlyEnginePtr start_engine_early(const EngineParams& e, const PrintConfig& c,
-                                  const TriangleMesh& mesh);
+                                  const TriangleMesh& mesh, bool layer_tops = false);
 
 /// Inputs: the engine, the mesh to slice (lowest point on the bed; its XY box centre stays
 /// where it is), the print settings it must agree with (layer heights), what this run asks.

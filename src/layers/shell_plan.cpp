@@ -2,6 +2,7 @@
 #include "layers/shell_plan.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -365,10 +366,11 @@ std::optional<std::vector<double>> region_shells_core(const TriangleMesh& mesh, 
     if (q.needs_nonplanar())
       for (int f : q.faces) curved[static_cast<std::size_t>(f)] = 1;
   // Over each curved facet's centre: H is about the highest curved facet there, and the part
-  // stands above it where another facet is higher still.
-  bool above = false;
-  for (std::size_t f = 0; f < mesh.faces.size() && !above; ++f) {
-    if (!curved[f]) continue;
+  // stands above it where another facet is higher still; and under each other facet's corners
+  // (a wall rising from a curved floor's edge). Blocks of facets side by side, each stopping
+  // once any has found the part above (a yes or no: the same whatever the threads).
+  std::atomic<bool> above{false};
+  const auto over_curved = [&](std::size_t f) {
     const auto& F = mesh.faces[f];
     const Vec3 c = (mesh.vertices[F[0]] + mesh.vertices[F[1]] + mesh.vertices[F[2]]) / 3.0;
     double top = c.z(), other = -std::numeric_limits<double>::infinity();
@@ -376,22 +378,23 @@ std::optional<std::vector<double>> region_shells_core(const TriangleMesh& mesh, 
       double& highest = curved[static_cast<std::size_t>(g)] ? top : other;
       highest = std::max(highest, z);
     }
-    above = other > top + kAbove;
-  }
-  // And under each other facet's corners (a wall rising from a curved floor's edge).
-  for (std::size_t f = 0; f < mesh.faces.size() && !above; ++f) {
-    if (curved[f]) continue;
+    return other > top + kAbove;
+  };
+  const auto above_curved = [&](std::size_t f) {
     for (int v : mesh.faces[f]) {
       const Vec3& c = mesh.vertices[static_cast<std::size_t>(v)];
       double top = -std::numeric_limits<double>::infinity();
       for (const auto& [z, g] : columns.face_hits(c.x(), c.y()))
         if (curved[static_cast<std::size_t>(g)]) top = std::max(top, z);
-      if (std::isfinite(top) && c.z() > top + kAbove) {
-        above = true;
-        break;
-      }
+      if (std::isfinite(top) && c.z() > top + kAbove) return true;
     }
-  }
+    return false;
+  };
+  core::parallel_blocks(std::size_t{0}, mesh.faces.size(), std::size_t{2048},
+                        [&](std::size_t lo, std::size_t hi) {
+                          for (std::size_t f = lo; f < hi && !above.load(); ++f)
+                            if (curved[f] ? over_curved(f) : above_curved(f)) above = true;
+                        });
   if (!above) return std::nullopt;
   // The shell over all the curved patches, H as low as their lowest point (plan_shell's H may
   // be lower beside them: the plan then has another first layer, and says so).

@@ -410,6 +410,46 @@ TEST(EnginePrusaSlicer, NoEarlyEngineForAMeshPrusaSlicerWouldRepair) {
   EXPECT_EQ(start_engine_early(e, c, open), nullptr);
   e.engine = Engine::orcaslicer;
   EXPECT_EQ(start_engine_early(e, c, test::placed(test::saddle(), c)), nullptr);
+  EXPECT_EQ(start_engine_early(e, c, open, true), nullptr);
+}
+
+// For a run with layer tops known to come (a shell's core), a mesh PrusaSlicer would repair
+// gets an engine started early all the same: it reads the 3MF a run started late reads,
+// written before its settings pipe is, and prints what that run prints. A run without layer
+// tops (an STL started late) leaves it alone.
+TEST(EnginePrusaSlicer, AnOpenMeshsEarlyEngineReadsTheCoresFile) {
+  if (!have_prusaslicer()) GTEST_SKIP() << "prusa-slicer not installed";
+  PrintConfig c;
+  const EngineParams e = prusaslicer();
+  TriangleMesh open = test::placed(test::saddle(), c);
+  open.faces.pop_back();
+  EngineRun core;
+  const double z0 = bounding_box(open).min.z();
+  for (double z : {0.17, 0.34, 0.52, 0.7, 0.87, 1.05, 1.22, 1.4, 1.57})
+    core.layer_tops.push_back(z0 + z);
+  auto late = run_engine(e, open, c, {}, core);
+  ASSERT_TRUE(late) << late.error().message;
+  {
+    EarlyEnginePtr early = start_engine_early(e, c, open, true);
+    ASSERT_NE(early, nullptr);
+    auto plain = run_engine(e, open, c, {}, {}, early.get());  // an STL's run: started late
+    ASSERT_TRUE(plain) << plain.error().message;
+    EXPECT_EQ(made(*plain).layers.size(), made(*run_engine(e, open, c, {})).layers.size());
+    int status = 0;
+    EXPECT_EQ(waitpid(-1, &status, WNOHANG), 0);  // the early one still waits, unused
+  }
+  EarlyEnginePtr early = start_engine_early(e, c, open, true);
+  ASSERT_NE(early, nullptr);
+  auto piped = run_engine(e, open, c, {}, core, early.get());
+  ASSERT_TRUE(piped) << piped.error().message;
+  int status = 0;
+  EXPECT_EQ(waitpid(-1, &status, WNOHANG), -1);  // it took the early one
+  EXPECT_EQ(errno, ECHILD);
+  expect_same_print(*piped, *late);
+  const Made p = made(*piped);
+  ASSERT_GT(p.layers.size(), 9u);
+  EXPECT_NEAR(std::stod(p.layers[0].substr(3)), 0.17, 1e-3);
+  EXPECT_NEAR(std::stod(p.layers[8].substr(3)), 1.57, 1e-3);
 }
 
 TEST(EngineOption, BadEngineOrMissingExecutableIsAOneLineError) {
