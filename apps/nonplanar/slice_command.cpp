@@ -220,7 +220,8 @@ void register_slice(CLI::App& app, std::function<int()>* run_fn) {
       "--timings", o->timings,
       "Print the wall and CPU time of each stage (load, analyze, fit, layers, normalize, "
       "slice, toolpaths or engine, map back, gate, gcode, collisions, stats, write), a retry's "
-      "stages again in order, on stderr; 'cores' below 2 shows a core left idle");
+      "stages again in order, on stderr; 'cores' below 2 shows a core left idle, 'rss MB' "
+      "the memory in use when the stage ends, 'peak MB' the run's peak so far");
   cmd->add_flag("--preview", o->preview,
                 "Also write OUTPUT.html: the toolpaths in 3D with a slider over the layers "
                 "(see 'preview')");
