@@ -298,44 +298,32 @@ TEST(HostileInput, InterruptLeavesNoFiles) {
   const fs::path models = test::shared_models();
   if (models.empty()) GTEST_SKIP() << "../shared/models not present";
   const std::string model = (models / "np_stanford_bunny_closed_compas.stl").string();
-  // The moments are shares of an uninterrupted run's time here (from 10 s to 3 s over the
-  // project's life, so fixed delays would come to miss its end): early, middle, late. A run
-  // that still beats the signal (the machine got faster between the two) must have written
-  // its whole file; at least two of the three must have been interrupted.
-  auto run = [&](double delay, fs::path& dir, fs::path& log, int& status, double& waited) {
-    dir = test::temp_dir("hostile_sigint");
-    log = test::temp_dir("hostile_sigint_log") / "err";
-    const pid_t pid = start_cli({"slice", "-q", model, "-o", (dir / "bunny.gcode").string()}, log);
-    if (pid == 0) return false;
-    const auto t0 = std::chrono::steady_clock::now();
-    if (delay > 0) {
-      std::this_thread::sleep_for(std::chrono::duration<double>(delay));
-      ::kill(pid, SIGINT);
-    }
-    const auto t1 = std::chrono::steady_clock::now();
-    // A CLI that ignored the signal would hang here until the test's timeout.
-    if (::waitpid(pid, &status, 0) != pid) return false;
-    const auto t2 = std::chrono::steady_clock::now();
-    waited = std::chrono::duration<double>(t2 - (delay > 0 ? t1 : t0)).count();
-    return true;
-  };
-  fs::path dir, log;
-  int status = 0;
-  double whole = 0;
-  ASSERT_TRUE(run(0, dir, log, status, whole));
-  ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << test::read_bytes(log);
-  const std::string complete = test::read_bytes(dir / "bunny.gcode");
-  ASSERT_GT(complete.size(), 1000000u);
+  // Early, middle, late: the bunny took 10 s here once, 3 s now, minutes under a sanitizer, so
+  // a fast machine may finish before the last signal. Such a run must have written its whole
+  // file (it ends with its config block); at least two of the three must be interrupted.
   int interrupted = 0;
-  for (const double share : {0.05, 0.4, 0.8}) {
-    const double delay = share * whole;
-    double waited = 0;
-    ASSERT_TRUE(run(delay, dir, log, status, waited));
+  for (const double delay : {0.2, 1.0, 2.5}) {
+    const fs::path dir = test::temp_dir("hostile_sigint");
+    const fs::path log = test::temp_dir("hostile_sigint_log") / "err";
+    const std::string out = (dir / "bunny.gcode").string();
+    const pid_t pid = start_cli({"slice", "-q", model, "-o", out}, log);
+    ASSERT_NE(pid, 0);
+    std::this_thread::sleep_for(std::chrono::duration<double>(delay));
+    ::kill(pid, SIGINT);
+    const auto t0 = std::chrono::steady_clock::now();
+    int status = 0;
+    // A CLI that ignored the signal would hang here until the test's timeout.
+    ASSERT_EQ(::waitpid(pid, &status, 0), pid);
+    const double waited =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     ASSERT_TRUE(WIFEXITED(status)) << "killed by signal " << WTERMSIG(status);
     const auto left = listing(dir);
     if (WEXITSTATUS(status) == 0) {  // done before the signal came
-      EXPECT_EQ(left, std::vector<std::string>{"bunny.gcode"}) << "delay " << delay;
-      EXPECT_EQ(fs::file_size(dir / "bunny.gcode"), complete.size()) << "delay " << delay;
+      ASSERT_EQ(left, std::vector<std::string>{"bunny.gcode"}) << "delay " << delay;
+      const std::string g = test::read_bytes(out);
+      const std::string end = "; prusaslicer_config = end\n";
+      EXPECT_TRUE(g.size() > end.size() && g.compare(g.size() - end.size(), end.size(), end) == 0)
+          << "delay " << delay << ": a file without its end";
       continue;
     }
     ++interrupted;
@@ -345,7 +333,7 @@ TEST(HostileInput, InterruptLeavesNoFiles) {
     // Prompt: every stage checks the flag (generous for sanitizer builds on a shared machine).
     EXPECT_LT(waited, 30.0) << "delay " << delay;
   }
-  EXPECT_GE(interrupted, 2) << "the uninterrupted run took " << whole << " s";
+  EXPECT_GE(interrupted, 2);
 }
 
 // A stand-in engine: a shell script `body` saved as an executable in `dir`.
