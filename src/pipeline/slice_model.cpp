@@ -548,7 +548,7 @@ Expected<SliceResult> slice_rounds(const TriangleMesh& mesh, const SliceJob& job
     // on while the stacks and shells are planned (on the bunny 1.3 s), and any other run
     // stops it. A mesh PrusaSlicer would repair has no engine started early for any run: one
     // starts now for this one (the CurviSlicer car's run 0.3 s sooner).
-    if ((pre.engine || job.engine.engine == Engine::prusaslicer) && job.shells)
+    if (job.engine.engine == Engine::prusaslicer && job.shells)  // (pre.engine: PrusaSlicer's)
       if (auto core = layers::region_shells_core(mesh, pre.analysis, job.layers)) {
         if (!pre.engine) pre.engine = start_engine_early(job.engine, job.print, mesh, true);
         EngineRun run;
